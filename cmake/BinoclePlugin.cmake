@@ -1,0 +1,32 @@
+# SPDX-License-Identifier: MIT
+# binocle_add_plugin(<name> SOURCES <files...> [LIBRARIES <targets...>] [NO_INSTALL])
+#
+# Builds a Binocle plugin: a MODULE library with hidden visibility that exports only
+# its init symbol, named binocle_<name>.so. Installed with the SDK, so that a plugin
+# built outside this tree uses the very same function.
+function(binocle_add_plugin name)
+  cmake_parse_arguments(ARG "NO_INSTALL" "OUTPUT_DIRECTORY" "SOURCES;LIBRARIES" ${ARGN})
+  set(target binocle_plugin_${name})
+  add_library(${target} MODULE ${ARG_SOURCES})
+  if(TARGET Binocle::sdk)
+    target_link_libraries(${target} PRIVATE Binocle::sdk)
+  endif()
+  target_link_libraries(${target} PRIVATE ${ARG_LIBRARIES})
+  set_target_properties(${target} PROPERTIES
+    PREFIX ""
+    OUTPUT_NAME "binocle_${name}"
+    CXX_VISIBILITY_PRESET hidden
+    C_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON)
+  if(ARG_OUTPUT_DIRECTORY)
+    set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${ARG_OUTPUT_DIRECTORY}")
+  elseif(DEFINED BINOCLE_BUILD_PLUGIN_DIR)
+    set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${BINOCLE_BUILD_PLUGIN_DIR}")
+  endif()
+  if(TARGET binocle_all_plugins)
+    add_dependencies(binocle_all_plugins ${target})
+  endif()
+  if(NOT ARG_NO_INSTALL AND DEFINED BINOCLE_PLUGIN_INSTALL_DIR)
+    install(TARGETS ${target} LIBRARY DESTINATION "${BINOCLE_PLUGIN_INSTALL_DIR}")
+  endif()
+endfunction()

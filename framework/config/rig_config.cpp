@@ -1,0 +1,451 @@
+// SPDX-License-Identifier: MIT
+// Rig descriptions in YAML: loading, overrides, validation against plugin tables.
+#include "config/rig_config.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace binocle {
+
+std::string Location::str() const {
+    if (!override.empty()) return "command line --set " + override;
+    std::string s = file;
+    if (line > 0) s += ":" + std::to_string(line) + ":" + std::to_string(column);
+    return s;
+}
+
+Override Override::parse(const std::string &text) {
+    const auto eq = text.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw Error("--set " + text + ": expected KEY=VALUE, e.g. --set matcher.num_disparities=128");
+    Override o;
+    o.path = text.substr(0, eq);
+    o.value = text.substr(eq + 1);
+    o.text = text;
+    return o;
+}
+
+std::string nearest(const std::string &word, const std::vector<std::string> &candidates) {
+    auto distance = [](const std::string &a, const std::string &b) {
+        std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            cur[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j)
+                cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            std::swap(prev, cur);
+        }
+        return prev[b.size()];
+    };
+    std::string best;
+    size_t bestD = std::max<size_t>(2, word.size() / 3) + 1;
+    for (const auto &c : candidates) {
+        size_t d = distance(word, c);
+        // A prefix relation ("num_disparity" / "num_disparities") counts as close.
+        if (c.rfind(word, 0) == 0 || word.rfind(c, 0) == 0) d = std::min<size_t>(d, 1);
+        if (d < bestD) bestD = d, best = c;
+    }
+    return best;
+}
+
+namespace {
+
+std::vector<std::string> splitPath(const std::string &path) {
+    std::vector<std::string> parts;
+    std::string cur;
+    for (char c : path) {
+        if (c == '.' || c == '[' || c == ']') {
+            if (!cur.empty()) parts.push_back(cur);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    if (!cur.empty()) parts.push_back(cur);
+    return parts;
+}
+
+bool isIndex(const std::string &s) { return !s.empty() && std::all_of(s.begin(), s.end(), ::isdigit); }
+
+// Everything needed to say where a value came from.
+struct Context {
+    std::string file;
+    std::string base_dir;
+    std::vector<Override> overrides;
+
+    Location at(const YAML::Node &node, const std::string &path) const {
+        Location loc;
+        loc.file = file;
+        for (const auto &o : overrides) {
+            auto a = splitPath(o.path), b = splitPath(path);
+            if (a == b) {
+                loc.override = o.text;
+                return loc;
+            }
+        }
+        if (node.IsDefined() && !node.Mark().is_null()) {
+            loc.line = node.Mark().line + 1;
+            loc.column = node.Mark().column + 1;
+        }
+        return loc;
+    }
+    [[noreturn]] void fail(const YAML::Node &node, const std::string &path, const std::string &what) const {
+        throw Error(at(node, path).str() + ": " + path + ": " + what);
+    }
+};
+
+std::string scalarText(const YAML::Node &n) {
+    if (n.IsScalar()) return n.Scalar();
+    YAML::Emitter e;
+    e << YAML::Flow << n;
+    return e.c_str();
+}
+
+std::string describeChoices(const binocle_param_desc &d) {
+    std::string c = d.choices ? d.choices : "";
+    std::replace(c.begin(), c.end(), '|', ',');
+    return c;
+}
+
+std::string fmtNumber(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
+
+// Parses and checks one value against its description; stores it in `out`.
+void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n, bool isExplicit, const Context &ctx,
+              const std::string &path) {
+    const std::string text = scalarText(n);
+    auto bad = [&](const std::string &expected) {
+        ctx.fail(n, path, "value '" + text + "' is not valid: expected " + expected);
+    };
+    auto checkRange = [&](double v, const char *kind) {
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) bad(std::string(kind) + " >= " + fmtNumber(d.min));
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) bad(std::string(kind) + " <= " + fmtNumber(d.max));
+    };
+    switch (d.type) {
+    case BINOCLE_PARAM_BOOL: {
+        bool v = false;
+        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) bad("true or false");
+        out.setBool(d.name, v, isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_INT: {
+        long long v = 0;
+        std::string what = "an integer";
+        if (d.multiple_of > 0) what = "an integer multiple of " + std::to_string(d.multiple_of);
+        if (d.flags & BINOCLE_PARAM_FLAG_ODD) what = "an odd integer";
+        if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) what += " >= " + fmtNumber(d.min);
+        if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) what += " <= " + fmtNumber(d.max);
+        if (!n.IsScalar()) bad(what);
+        try {
+            size_t used = 0;
+            v = std::stoll(n.Scalar(), &used, 0);
+            if (used != n.Scalar().size()) bad(what);
+        } catch (const std::logic_error &) {
+            bad(what);
+        }
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) bad(what);
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) bad(what);
+        if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) bad(what);
+        if (d.multiple_of > 0 && v % d.multiple_of != 0) bad(what);
+        out.setInt(d.name, v, isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_DOUBLE: {
+        double v = 0;
+        if (!n.IsScalar()) bad("a number");
+        try {
+            size_t used = 0;
+            v = std::stod(n.Scalar(), &used);
+            if (used != n.Scalar().size()) bad("a number");
+        } catch (const std::logic_error &) {
+            bad("a number");
+        }
+        if (!std::isfinite(v)) bad("a finite number");
+        checkRange(v, "a number");
+        out.setDouble(d.name, v, isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_ENUM: {
+        std::string choices = d.choices ? d.choices : "";
+        std::vector<std::string> list;
+        std::stringstream ss(choices);
+        for (std::string c; std::getline(ss, c, '|');) list.push_back(c);
+        if (!n.IsScalar() || std::find(list.begin(), list.end(), n.Scalar()) == list.end()) {
+            std::string hint = n.IsScalar() ? nearest(n.Scalar(), list) : "";
+            bad("one of " + describeChoices(d) + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+        }
+        out.setText(d.name, d.type, n.Scalar(), isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_STRING:
+        if (!n.IsScalar()) bad("a string");
+        out.setText(d.name, d.type, n.Scalar(), isExplicit);
+        break;
+    case BINOCLE_PARAM_PATH: {
+        if (!n.IsScalar()) bad("a path");
+        std::string p = n.Scalar();
+        if (!p.empty() && fs::path(p).is_relative() && !ctx.base_dir.empty()) p = (fs::path(ctx.base_dir) / p).lexically_normal().string();
+        out.setText(d.name, d.type, p, isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_INT_LIST:
+    case BINOCLE_PARAM_DOUBLE_LIST: {
+        const bool ints = d.type == BINOCLE_PARAM_INT_LIST;
+        const char *what = ints ? "a list of integers, e.g. [1, 2]" : "a list of numbers, e.g. [0.1, 0.2]";
+        if (!n.IsSequence()) bad(what);
+        for (const auto &e : n) {
+            try {
+                if (ints) (void)e.as<long long>();
+                else (void)e.as<double>();
+            } catch (const YAML::Exception &) {
+                bad(what);
+            }
+        }
+        out.setText(d.name, d.type, scalarText(n), isExplicit);
+        break;
+    }
+    case BINOCLE_PARAM_YAML: {
+        YAML::Emitter e;
+        e << n;
+        out.setText(d.name, d.type, e.c_str(), isExplicit);
+        break;
+    }
+    default: ctx.fail(n, path, "setting of unknown type " + std::to_string(d.type));
+    }
+}
+
+ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, const std::string &where, const Context &ctx) {
+    const auto descs = record.params();
+    std::vector<std::string> names;
+    for (const auto &d : descs) names.emplace_back(d.name);
+    if (block.IsDefined() && !block.IsNull() && !block.IsMap())
+        ctx.fail(block, where, "expected a map of settings for plugin '" + record.name + "'");
+    if (block.IsMap()) {
+        for (const auto &kv : block) {
+            const std::string key = kv.first.as<std::string>();
+            if (key == "plugin") continue;
+            if (std::find(names.begin(), names.end(), key) != names.end()) continue;
+            std::string hint = nearest(key, names);
+            std::string all;
+            for (const auto &n : names) all += (all.empty() ? "" : ", ") + n;
+            throw Error(ctx.at(kv.first, where + "." + key).str() + ": " + where + ": unknown key '" + key + "' for plugin '" +
+                        record.name + "'" + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                        " (valid keys: " + (all.empty() ? "none" : all) + ")");
+        }
+    }
+    ParamValues values;
+    for (const auto &d : descs) {
+        const std::string path = where + "." + d.name;
+        YAML::Node n = block.IsMap() ? block[d.name] : YAML::Node();
+        if (n.IsDefined() && !n.IsNull()) {
+            setValue(values, d, n, true, ctx, path);
+        } else if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED || !d.default_value) {
+            ctx.fail(block, where, "missing key '" + std::string(d.name) + "' for plugin '" + record.name + "'" +
+                                       (d.help && *d.help ? " (" + std::string(d.help) + ")" : ""));
+        } else {
+            YAML::Node def;
+            try {
+                def = YAML::Load(d.default_value);
+            } catch (const YAML::Exception &) {
+                def = YAML::Node(std::string(d.default_value));
+            }
+            Context pluginCtx{record.path, ctx.base_dir, {}};
+            if (def.IsNull() && d.type != BINOCLE_PARAM_YAML) def = YAML::Node(std::string());
+            setValue(values, d, def, false, pluginCtx, record.name + " default of " + d.name);
+        }
+    }
+    return values;
+}
+
+const std::vector<std::string> kTopKeys = {"name", "description", "source", "calibration", "matcher",
+                                           "transforms", "evaluators", "outputs"};
+const std::vector<std::string> kOutputKeys = {"disparity_png", "disparity_color", "disparity_pfm", "cloud_ply",
+                                              "rectified_png", "max_range_mm"};
+
+PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind, const PluginHost &host,
+                  const Context &ctx) {
+    if (!node.IsDefined() || node.IsNull()) throw Error(ctx.file + ": missing block '" + where + "' (with a 'plugin:' key)");
+    if (!node.IsMap()) ctx.fail(node, where, std::string("expected a map with 'plugin: <name>' and the plugin's settings"));
+    YAML::Node p = node["plugin"];
+    if (!p.IsDefined() || !p.IsScalar()) ctx.fail(node, where, std::string("missing key 'plugin' (the ") + kindName(kind) + " plugin's name)");
+    PluginBlock b;
+    b.where = where;
+    b.plugin = p.Scalar();
+    b.location = ctx.at(node, where);
+    b.record = host.find(b.plugin, kind);
+    if (!b.record) {
+        std::vector<std::string> names;
+        for (const auto &r : host.plugins())
+            if (r.kind == kind) names.push_back(r.name);
+        std::string hint = nearest(b.plugin, names), all;
+        for (const auto &n : names) all += (all.empty() ? "" : ", ") + n;
+        std::string refused;
+        for (const auto &r : host.refused())
+            if (fs::path(r.path).stem().string() == "binocle_" + b.plugin) refused = "; " + r.path + " was refused: " + r.reason;
+        ctx.fail(p, where + ".plugin", std::string("no ") + kindName(kind) + " plugin named '" + b.plugin + "'" +
+                                           (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                                           " (available: " + (all.empty() ? "none" : all) + ")" + refused);
+    }
+    b.params = resolveWith(*b.record, node, where, ctx);
+    return b;
+}
+
+std::vector<PluginBlock> blockList(const YAML::Node &node, const std::string &where, int32_t kind, const PluginHost &host,
+                                   const Context &ctx) {
+    std::vector<PluginBlock> out;
+    if (!node.IsDefined() || node.IsNull()) return out;
+    if (!node.IsSequence()) ctx.fail(node, where, "expected a list of plugin blocks (- plugin: <name> ...)");
+    for (size_t i = 0; i < node.size(); ++i)
+        out.push_back(block(node[i], where + "[" + std::to_string(i) + "]", kind, host, ctx));
+    return out;
+}
+
+RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &host) {
+    if (!root.IsMap()) throw Error(ctx.file + ": expected a YAML map with source, matcher, ... at the top level");
+    for (const auto &kv : root) {
+        const std::string key = kv.first.as<std::string>();
+        if (std::find(kTopKeys.begin(), kTopKeys.end(), key) != kTopKeys.end()) continue;
+        std::string hint = nearest(key, kTopKeys);
+        throw Error(ctx.at(kv.first, key).str() + ": unknown key '" + key + "'" +
+                    (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                    " (valid keys: name, description, source, calibration, matcher, transforms, evaluators, outputs)");
+    }
+    RigConfig rig;
+    rig.file = ctx.file;
+    rig.base_dir = ctx.base_dir;
+    rig.name = root["name"] ? root["name"].as<std::string>() : fs::path(ctx.file).stem().string();
+    rig.source = block(root["source"], "source", BINOCLE_KIND_STEREO_SOURCE, host, ctx);
+    rig.matcher = block(root["matcher"], "matcher", BINOCLE_KIND_MATCHER, host, ctx);
+    rig.transforms = blockList(root["transforms"], "transforms", BINOCLE_KIND_CLOUD_TRANSFORM, host, ctx);
+    rig.evaluators = blockList(root["evaluators"], "evaluators", BINOCLE_KIND_EVALUATOR, host, ctx);
+    if (YAML::Node c = root["calibration"]; c.IsDefined() && !c.IsNull()) {
+        if (!c.IsScalar()) ctx.fail(c, "calibration", "expected the path of a calibration file (OpenCV FileStorage YAML)");
+        fs::path p = c.Scalar();
+        if (p.is_relative()) p = fs::path(ctx.base_dir) / p;
+        if (!fs::exists(p)) ctx.fail(c, "calibration", "file '" + p.string() + "' does not exist");
+        rig.calibration_file = p.lexically_normal().string();
+    }
+    if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
+        if (!o.IsMap()) ctx.fail(o, "outputs", "expected a map (disparity_png: true, ...)");
+        for (const auto &kv : o) {
+            const std::string key = kv.first.as<std::string>();
+            if (std::find(kOutputKeys.begin(), kOutputKeys.end(), key) == kOutputKeys.end()) {
+                std::string hint = nearest(key, kOutputKeys);
+                throw Error(ctx.at(kv.first, "outputs." + key).str() + ": outputs: unknown key '" + key + "'" +
+                            (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                            " (valid keys: disparity_png, disparity_color, disparity_pfm, cloud_ply, rectified_png, max_range_mm)");
+            }
+        }
+        auto flag = [&](const char *key, bool &v) {
+            YAML::Node n = o[key];
+            if (!n) return;
+            if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+                ctx.fail(n, std::string("outputs.") + key, "value '" + scalarText(n) + "' is not valid: expected true or false");
+        };
+        flag("disparity_png", rig.outputs.disparity_png);
+        flag("disparity_color", rig.outputs.disparity_color);
+        flag("disparity_pfm", rig.outputs.disparity_pfm);
+        flag("cloud_ply", rig.outputs.cloud_ply);
+        flag("rectified_png", rig.outputs.rectified_png);
+        if (YAML::Node n = o["max_range_mm"]) {
+            double v = 0;
+            if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !(v > 0))
+                ctx.fail(n, "outputs.max_range_mm", "value '" + scalarText(n) + "' is not valid: expected a positive number of mm");
+            rig.outputs.max_range_mm = v;
+        }
+    }
+    YAML::Emitter e;
+    e << root;
+    rig.resolved_yaml = e.c_str();
+    return rig;
+}
+
+} // namespace
+
+void applyOverride(YAML::Node &root, const Override &o) {
+    const auto parts = splitPath(o.path);
+    if (parts.empty()) throw Error("--set " + o.text + ": empty key");
+    YAML::Node value;
+    try {
+        value = YAML::Load(o.value);
+    } catch (const YAML::Exception &e) {
+        throw Error("--set " + o.text + ": value is not valid YAML: " + e.msg);
+    }
+    // Walk with fresh handles: yaml-cpp node assignment would rebind, not descend.
+    std::vector<YAML::Node> chain{root};
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+        YAML::Node cur = chain.back();
+        YAML::Node next;
+        if (cur.IsSequence()) {
+            if (!isIndex(parts[i]) || std::stoul(parts[i]) >= cur.size())
+                throw Error("--set " + o.text + ": '" + parts[i] + "' is not an index of the list (0.." +
+                            std::to_string(cur.size() ? cur.size() - 1 : 0) + ")");
+            next = cur[std::stoul(parts[i])];
+        } else if (cur.IsMap() || cur.IsNull() || !cur.IsDefined()) {
+            next = cur[parts[i]];
+            if (!next.IsDefined() || next.IsNull()) {
+                cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
+                next = cur[parts[i]];
+            }
+        } else {
+            throw Error("--set " + o.text + ": '" + parts[i] + "' leads into a scalar value");
+        }
+        chain.push_back(next);
+    }
+    YAML::Node last = chain.back();
+    if (last.IsSequence()) {
+        if (!isIndex(parts.back()) || std::stoul(parts.back()) >= last.size())
+            throw Error("--set " + o.text + ": '" + parts.back() + "' is not an index of the list");
+        last[std::stoul(parts.back())] = value;
+    } else if (last.IsScalar()) {
+        throw Error("--set " + o.text + ": the parent of '" + parts.back() + "' is a scalar value");
+    } else {
+        last[parts.back()] = value;
+    }
+}
+
+RigConfig loadRig(const std::string &file, const std::vector<Override> &overrides, const PluginHost &host) {
+    std::error_code ec;
+    const std::string abs = fs::absolute(file, ec).lexically_normal().string();
+    if (!fs::exists(abs)) throw Error("rig file " + file + " does not exist");
+    YAML::Node root;
+    try {
+        root = YAML::LoadFile(abs);
+    } catch (const YAML::ParserException &e) {
+        throw Error(abs + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                    ": YAML syntax error: " + e.msg);
+    } catch (const YAML::Exception &e) {
+        throw Error(abs + ": cannot read YAML: " + e.msg);
+    }
+    for (const auto &o : overrides) applyOverride(root, o);
+    Context ctx{abs, fs::path(abs).parent_path().string(), overrides};
+    return build(root, ctx, host);
+}
+
+RigConfig rigFromNode(const YAML::Node &root, const std::string &file, const PluginHost &host) {
+    Context ctx{file, fs::path(file).parent_path().string(), {}};
+    return build(root, ctx, host);
+}
+
+ParamValues resolveParams(const PluginRecord &record, const YAML::Node &block, const std::string &where,
+                          const std::string &file, const std::string &base_dir) {
+    Context ctx{file, base_dir, {}};
+    return resolveWith(record, block, where, ctx);
+}
+
+ParamValues paramsFromYaml(const PluginRecord &record, const std::string &yaml) {
+    YAML::Node n = YAML::Load(yaml);
+    std::error_code ec;
+    return resolveParams(record, n, record.name, "(inline YAML)", fs::current_path(ec).string());
+}
+
+} // namespace binocle

@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// Rig descriptions in YAML: one file composes a source, a calibration, a matcher, cloud
+// transforms, evaluators and outputs. Every plugin block is validated against the
+// plugin's own settings table; errors name file, line, column, key, value and what was
+// expected.
+#pragma once
+
+#include "host/plugin_host.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+#include <yaml-cpp/yaml.h>
+
+namespace binocle {
+
+// Where a node came from, for error messages: "rig.yaml:12:5" or "--set matcher.x=1".
+struct Location {
+    std::string file;
+    int line = 0, column = 0; // 1-based; 0 when the value came from the command line
+    std::string override;      // the --set text, when it came from there
+    std::string str() const;
+};
+
+// One plugin block: `plugin: <name>` plus that plugin's settings.
+struct PluginBlock {
+    std::string where;  // "matcher", "transforms[0]"
+    std::string plugin; // plugin name
+    const PluginRecord *record = nullptr;
+    ParamValues params;
+    Location location;
+};
+
+struct OutputOptions {
+    bool disparity_png = true;   // 16-bit KITTI PNG
+    bool disparity_color = true; // colourised PNG
+    bool disparity_pfm = false;
+    bool cloud_ply = true;
+    bool rectified_png = false;
+    double max_range_mm = 50000; // points farther are dropped from the cloud
+};
+
+struct RigConfig {
+    std::string file;     // absolute path of the YAML
+    std::string base_dir; // its folder: relative paths resolve against it
+    std::string name;
+    PluginBlock source;
+    std::optional<std::string> calibration_file; // overrides the source's calibration
+    PluginBlock matcher;
+    std::vector<PluginBlock> transforms;
+    std::vector<PluginBlock> evaluators;
+    OutputOptions outputs;
+    std::string resolved_yaml; // the rig after --set overrides
+};
+
+// "key=value" with a dotted key path ("matcher.num_disparities=128",
+// "transforms.0.inclination_deg=10"); the value is parsed as YAML.
+struct Override {
+    std::string path;
+    std::string value;
+    std::string text;
+    static Override parse(const std::string &text); // throws Error on a malformed text
+};
+
+// Loads, applies overrides, validates against the plugins `host` found.
+RigConfig loadRig(const std::string &file, const std::vector<Override> &overrides, const PluginHost &host);
+// Same from a YAML tree already loaded (experiments build rigs this way).
+RigConfig rigFromNode(const YAML::Node &root, const std::string &file, const PluginHost &host);
+
+// Applies one override to a tree; creates missing maps; throws on a path through a scalar.
+void applyOverride(YAML::Node &root, const Override &o);
+
+// Validates a plugin block against the plugin's table and returns the values it gets.
+// `block` is a map with `plugin:` (ignored here) and settings.
+ParamValues resolveParams(const PluginRecord &record, const YAML::Node &block, const std::string &where,
+                          const std::string &file, const std::string &base_dir);
+// All defaults of a plugin, plus the given YAML text (a map) on top: handy for tests.
+ParamValues paramsFromYaml(const PluginRecord &record, const std::string &yaml = "{}");
+
+// Closest candidate by edit distance, or "" when none is close.
+std::string nearest(const std::string &word, const std::vector<std::string> &candidates);
+
+} // namespace binocle

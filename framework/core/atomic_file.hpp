@@ -1,0 +1,21 @@
+// SPDX-License-Identifier: MIT
+// Whole-file reads and crash-safe writes: a result file is either complete or absent.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace binocle {
+
+// Throws binocle::Error naming the path when it cannot be read.
+std::string readTextFile(const std::string &path);
+
+// Writes to "<path>.tmp-<pid>", flushes, then renames over path. On failure the old
+// file (if any) is untouched and the temporary is removed.
+void writeFileAtomic(const std::string &path, const std::string &bytes);
+
+// Same, for writers that need a file name (cv::imwrite): `write` receives the temporary
+// path, which keeps the extension of `path` so that the format is chosen right.
+void writeFileAtomicWith(const std::string &path, const std::function<void(const std::string &tmp)> &write);
+
+} // namespace binocle

@@ -1,0 +1,686 @@
+// SPDX-License-Identifier: MIT
+// The plugin host: search path, loading with Boost.DLL, ABI checks, instance wrappers.
+#include "host/plugin_host.hpp"
+
+#include <algorithm>
+#include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/shared_library.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace binocle {
+
+const char *kindName(int32_t kind) {
+    switch (kind) {
+    case BINOCLE_KIND_STEREO_SOURCE: return "source";
+    case BINOCLE_KIND_MATCHER: return "matcher";
+    case BINOCLE_KIND_CLOUD_TRANSFORM: return "transform";
+    case BINOCLE_KIND_EVALUATOR: return "evaluator";
+    default: return "unknown";
+    }
+}
+
+const char *resultName(int32_t code) {
+    switch (code) {
+    case BINOCLE_OK: return "BINOCLE_OK";
+    case BINOCLE_ERR_INVALID_ARGUMENT: return "BINOCLE_ERR_INVALID_ARGUMENT";
+    case BINOCLE_ERR_NOT_FOUND: return "BINOCLE_ERR_NOT_FOUND";
+    case BINOCLE_ERR_IO: return "BINOCLE_ERR_IO";
+    case BINOCLE_ERR_DEVICE: return "BINOCLE_ERR_DEVICE";
+    case BINOCLE_ERR_TIMEOUT: return "BINOCLE_ERR_TIMEOUT";
+    case BINOCLE_ERR_END_OF_STREAM: return "BINOCLE_ERR_END_OF_STREAM";
+    case BINOCLE_ERR_UNSUPPORTED: return "BINOCLE_ERR_UNSUPPORTED";
+    case BINOCLE_ERR_BUSY: return "BINOCLE_ERR_BUSY";
+    case BINOCLE_ERR_INTERNAL: return "BINOCLE_ERR_INTERNAL";
+    default: return code >= BINOCLE_ERR_VENDOR_BASE ? "vendor error" : "unknown error";
+    }
+}
+
+// ---- Records ------------------------------------------------------------------------
+
+namespace {
+
+// Size of each kind's table in ABI 1, API 1: the least a plugin may declare.
+size_t minimumTableSize(int32_t kind) {
+    switch (kind) {
+    case BINOCLE_KIND_STEREO_SOURCE: return sizeof(binocle_source_api);
+    case BINOCLE_KIND_MATCHER: return sizeof(binocle_matcher_api);
+    case BINOCLE_KIND_CLOUD_TRANSFORM: return sizeof(binocle_cloud_transform_api);
+    case BINOCLE_KIND_EVALUATOR: return sizeof(binocle_evaluator_api);
+    default: return 0;
+    }
+}
+
+struct ParamTable {
+    const binocle_param_desc *params;
+    int32_t count;
+};
+
+ParamTable paramTable(const binocle_plugin_header *h) {
+    switch (h->kind) {
+    case BINOCLE_KIND_STEREO_SOURCE: {
+        auto t = reinterpret_cast<const binocle_source_api *>(h);
+        return {t->params, t->param_count};
+    }
+    case BINOCLE_KIND_MATCHER: {
+        auto t = reinterpret_cast<const binocle_matcher_api *>(h);
+        return {t->params, t->param_count};
+    }
+    case BINOCLE_KIND_CLOUD_TRANSFORM: {
+        auto t = reinterpret_cast<const binocle_cloud_transform_api *>(h);
+        return {t->params, t->param_count};
+    }
+    case BINOCLE_KIND_EVALUATOR: {
+        auto t = reinterpret_cast<const binocle_evaluator_api *>(h);
+        return {t->params, t->param_count};
+    }
+    default: return {nullptr, 0};
+    }
+}
+
+// Names of the mandatory entries that are NULL.
+std::vector<std::string> missingEntries(const binocle_plugin_header *h) {
+    std::vector<std::string> missing;
+    auto need = [&](const void *p, const char *name) {
+        if (!p) missing.emplace_back(name);
+    };
+    switch (h->kind) {
+    case BINOCLE_KIND_STEREO_SOURCE: {
+        auto t = reinterpret_cast<const binocle_source_api *>(h);
+        need(reinterpret_cast<const void *>(t->create), "create");
+        need(reinterpret_cast<const void *>(t->destroy), "destroy");
+        need(reinterpret_cast<const void *>(t->last_error), "last_error");
+        need(reinterpret_cast<const void *>(t->grab), "grab");
+        need(reinterpret_cast<const void *>(t->release_frame), "release_frame");
+        break;
+    }
+    case BINOCLE_KIND_MATCHER: {
+        auto t = reinterpret_cast<const binocle_matcher_api *>(h);
+        need(reinterpret_cast<const void *>(t->create), "create");
+        need(reinterpret_cast<const void *>(t->destroy), "destroy");
+        need(reinterpret_cast<const void *>(t->last_error), "last_error");
+        need(reinterpret_cast<const void *>(t->compute), "compute");
+        break;
+    }
+    case BINOCLE_KIND_CLOUD_TRANSFORM: {
+        auto t = reinterpret_cast<const binocle_cloud_transform_api *>(h);
+        need(reinterpret_cast<const void *>(t->create), "create");
+        need(reinterpret_cast<const void *>(t->destroy), "destroy");
+        need(reinterpret_cast<const void *>(t->last_error), "last_error");
+        need(reinterpret_cast<const void *>(t->apply), "apply");
+        break;
+    }
+    case BINOCLE_KIND_EVALUATOR: {
+        auto t = reinterpret_cast<const binocle_evaluator_api *>(h);
+        need(reinterpret_cast<const void *>(t->create), "create");
+        need(reinterpret_cast<const void *>(t->destroy), "destroy");
+        need(reinterpret_cast<const void *>(t->last_error), "last_error");
+        need(reinterpret_cast<const void *>(t->evaluate), "evaluate");
+        break;
+    }
+    default: break;
+    }
+    return missing;
+}
+
+bool validName(const char *name) {
+    if (!name || !*name) return false;
+    for (const char *c = name; *c; ++c)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_')) return false;
+    return true;
+}
+
+std::string join(const std::vector<std::string> &v, const char *sep = ", ") {
+    std::string out;
+    for (size_t i = 0; i < v.size(); ++i) out += (i ? sep : "") + v[i];
+    return out;
+}
+
+} // namespace
+
+std::vector<binocle_param_desc> PluginRecord::params() const {
+    ParamTable t = paramTable(table);
+    if (!t.params || t.count <= 0) return {};
+    return {t.params, t.params + t.count};
+}
+
+// ---- Search and load ---------------------------------------------------------------------
+
+std::vector<std::string> PluginHost::defaultSearchPath() {
+    std::vector<std::string> path;
+    if (const char *env = std::getenv("BINOCLE_PLUGIN_PATH")) {
+        std::stringstream ss(env);
+        std::string dir;
+        while (std::getline(ss, dir, ':'))
+            if (!dir.empty()) path.push_back(dir);
+    }
+    try {
+        fs::path exe = boost::dll::program_location().string();
+        path.push_back((exe.parent_path().parent_path() / BINOCLE_PLUGIN_INSTALL_DIR).string());
+    } catch (...) {
+        // No program location (unusual); the other entries still apply.
+    }
+    path.emplace_back(BINOCLE_BUILD_PLUGIN_DIR);
+    return path;
+}
+
+PluginHost::PluginHost(std::vector<std::string> searchPath) : searchPath_(std::move(searchPath)) {}
+PluginHost::~PluginHost() = default;
+
+void PluginHost::scan() {
+    for (const auto &dir : searchPath_) {
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) continue;
+        std::vector<fs::path> files;
+        for (const auto &entry : fs::directory_iterator(dir, ec)) {
+            const auto name = entry.path().filename().string();
+            if (entry.is_regular_file(ec) && name.rfind("binocle_", 0) == 0 && entry.path().extension() == ".so")
+                files.push_back(entry.path());
+        }
+        std::sort(files.begin(), files.end());
+        for (const auto &f : files) {
+            const std::string canonical = fs::weakly_canonical(f, ec).string();
+            bool seen = std::any_of(plugins_.begin(), plugins_.end(), [&](const PluginRecord &r) { return r.path == canonical; }) ||
+                        std::any_of(refused_.begin(), refused_.end(), [&](const Refusal &r) { return r.path == canonical; });
+            if (seen) continue;
+            try {
+                inspect(canonical);
+            } catch (const Error &e) {
+                refused_.push_back({canonical, e.what()});
+            }
+        }
+    }
+}
+
+const PluginRecord &PluginHost::load(const std::string &path) {
+    std::error_code ec;
+    const std::string canonical = fs::weakly_canonical(path, ec).string();
+    for (const auto &r : plugins_)
+        if (r.path == canonical) return r;
+    try {
+        return inspect(canonical);
+    } catch (const Error &e) {
+        throw Error("plugin file " + canonical + " refused: " + e.what());
+    }
+}
+
+const PluginRecord &PluginHost::inspect(const std::string &path) {
+    auto lib = std::make_shared<boost::dll::shared_library>();
+    try {
+        lib->load(path, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+    } catch (const std::exception &e) {
+        throw Error(std::string("cannot be loaded: ") + e.what());
+    }
+    if (!lib->has(BINOCLE_PLUGIN_INIT_SYMBOL))
+        throw Error(std::string("no init symbol '") + BINOCLE_PLUGIN_INIT_SYMBOL +
+                    "' (not a Binocle plugin, or built without a BINOCLE_EXPORT_* macro)");
+    auto init = lib->get<const binocle_plugin_header *(uint32_t, uint32_t)>(BINOCLE_PLUGIN_INIT_SYMBOL);
+    const binocle_plugin_header *h = nullptr;
+    try {
+        h = init(BINOCLE_ABI_VERSION, BINOCLE_API_VERSION);
+    } catch (...) {
+        throw Error("init symbol threw an exception (exceptions must not cross the ABI)");
+    }
+    if (!h)
+        throw Error("init returned no table for host ABI " + std::to_string(BINOCLE_ABI_VERSION) + ", API " +
+                    std::to_string(BINOCLE_API_VERSION));
+    // The header layout is frozen: these fields are safe to read whatever the ABI.
+    if (h->abi_version != BINOCLE_ABI_VERSION)
+        throw Error("built for ABI version " + std::to_string(h->abi_version) + ", but this host speaks ABI version " +
+                    std::to_string(BINOCLE_ABI_VERSION) + " (rebuild the plugin against this SDK)");
+    if (h->struct_size < sizeof(binocle_plugin_header))
+        throw Error("table size " + std::to_string(h->struct_size) + " is smaller than the plugin header (" +
+                    std::to_string(sizeof(binocle_plugin_header)) + " bytes)");
+    const size_t minSize = minimumTableSize(h->kind);
+    if (minSize == 0) throw Error("unknown plugin kind " + std::to_string(h->kind));
+    if (h->struct_size < minSize)
+        throw Error("table size " + std::to_string(h->struct_size) + " is smaller than the " + kindName(h->kind) +
+                    " table of ABI " + std::to_string(BINOCLE_ABI_VERSION) + " (" + std::to_string(minSize) + " bytes)");
+    if (!validName(h->name))
+        throw Error(std::string("invalid plugin name '") + (h->name ? h->name : "(null)") + "' (expected [a-z0-9_]+)");
+    auto missing = missingEntries(h);
+    if (!missing.empty()) throw Error(std::string("plugin '") + h->name + "' leaves mandatory entries NULL: " + join(missing));
+    ParamTable pt = paramTable(h);
+    if (pt.count < 0 || pt.count > 1000 || (pt.count > 0 && !pt.params))
+        throw Error(std::string("plugin '") + h->name + "' declares a garbage settings table (count " + std::to_string(pt.count) + ")");
+    for (int32_t i = 0; i < pt.count; ++i) {
+        const auto &d = pt.params[i];
+        if (!validName(d.name) || d.type < BINOCLE_PARAM_BOOL || d.type > BINOCLE_PARAM_DOUBLE_LIST)
+            throw Error(std::string("plugin '") + h->name + "' declares an invalid setting #" + std::to_string(i));
+    }
+    if (const PluginRecord *other = find(h->name))
+        throw Error(std::string("plugin name '") + h->name + "' is already provided by " + other->path);
+
+    PluginRecord r;
+    r.path = path;
+    r.name = h->name;
+    r.version = h->version ? h->version : "";
+    r.description = h->description ? h->description : "";
+    r.kind = h->kind;
+    r.abi_version = h->abi_version;
+    r.api_version = h->api_version;
+    r.table = h;
+    r.library = lib;
+    plugins_.push_back(std::move(r));
+    return plugins_.back();
+}
+
+const PluginRecord *PluginHost::find(const std::string &name, int32_t kind) const {
+    for (const auto &r : plugins_)
+        if (r.name == name && (kind == 0 || r.kind == kind)) return &r;
+    return nullptr;
+}
+
+const PluginRecord &PluginHost::require(const std::string &name, int32_t kind) const {
+    if (const PluginRecord *r = find(name, kind)) return *r;
+    std::vector<std::string> names;
+    for (const auto &r : plugins_)
+        if (kind == 0 || r.kind == kind) names.push_back(r.name);
+    std::string msg = std::string("no ") + (kind ? kindName(kind) : "") + " plugin named '" + name + "'";
+    if (const PluginRecord *other = find(name)) msg += " (a " + std::string(kindName(other->kind)) + " plugin has that name)";
+    msg += "; available: " + (names.empty() ? std::string("none") : join(names));
+    for (const auto &ref : refused_)
+        if (fs::path(ref.path).stem().string() == "binocle_" + name)
+            msg += "; " + ref.path + " was refused: " + ref.reason;
+    msg += " (search path: " + join(searchPath_, ":") + ")";
+    throw Error(msg);
+}
+
+// ---- Settings -------------------------------------------------------------------------------
+
+binocle_param &ParamValues::slot(const std::string &name) {
+    for (auto &p : values_)
+        if (name == p.name) return p;
+    strings_.push_back(std::make_shared<std::string>(name));
+    binocle_param p{};
+    p.name = strings_.back()->c_str();
+    values_.push_back(p);
+    return values_.back();
+}
+
+void ParamValues::setBool(const std::string &name, bool v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_BOOL;
+    p.i = v ? 1 : 0;
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setInt(const std::string &name, int64_t v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_INT;
+    p.i = v;
+    p.d = static_cast<double>(v);
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setDouble(const std::string &name, double v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_DOUBLE;
+    p.d = v;
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setText(const std::string &name, int32_t type, const std::string &v, bool isExplicit) {
+    auto &p = slot(name);
+    strings_.push_back(std::make_shared<std::string>(v));
+    p.type = type;
+    p.s = strings_.back()->c_str();
+    p.explicit_ = isExplicit;
+}
+
+const binocle_param *ParamValues::data() const { return values_.data(); }
+int32_t ParamValues::size() const { return static_cast<int32_t>(values_.size()); }
+
+const binocle_param *ParamValues::find(const std::string &name) const {
+    for (const auto &p : values_)
+        if (name == p.name) return &p;
+    return nullptr;
+}
+
+// ---- Instances ---------------------------------------------------------------------------------
+
+namespace {
+
+struct SinkContext {
+    std::string plugin;
+    HostSink sink;
+};
+
+void hostLog(void *ctx, int32_t level, const char *message) {
+    try {
+        auto *c = static_cast<SinkContext *>(ctx);
+        std::string msg = message ? message : "";
+        if (c->sink.log) return c->sink.log(level, msg);
+        if (level < BINOCLE_LOG_INFO) return;
+        static const char *names[] = {"debug", "info", "warning", "error"};
+        std::cerr << "[" << c->plugin << "] " << names[std::clamp(level, 0, 3)] << ": " << msg << "\n";
+    } catch (...) {
+    }
+}
+
+void hostMetric(void *ctx, const char *name, double value, const char *unit) {
+    try {
+        auto *c = static_cast<SinkContext *>(ctx);
+        if (c->sink.metric) c->sink.metric(name ? name : "", value, unit ? unit : "");
+    } catch (...) {
+    }
+}
+
+void hostText(void *ctx, const char *name, const char *text) {
+    try {
+        auto *c = static_cast<SinkContext *>(ctx);
+        if (c->sink.text) c->sink.text(name ? name : "", text ? text : "");
+    } catch (...) {
+    }
+}
+
+// One SinkContext per binocle_host; owned through the binocle_host's context pointer.
+struct HostBlock {
+    binocle_host host;
+    SinkContext ctx;
+};
+
+// binocle_host is the first member: deleting through it deletes the block.
+void deleteHostBlock(binocle_host *h) { delete reinterpret_cast<HostBlock *>(h); }
+
+} // namespace
+
+PluginInstanceBase::PluginInstanceBase(const PluginRecord &record) : record_(record) {
+    auto block = new HostBlock{};
+    block->ctx.plugin = record.name;
+    block->host.struct_size = sizeof(binocle_host);
+    block->host.context = &block->ctx;
+    block->host.log = &hostLog;
+    block->host.report_metric = &hostMetric;
+    block->host.report_text = &hostText;
+    host_ = std::shared_ptr<binocle_host>(&block->host, deleteHostBlock);
+}
+
+void PluginInstanceBase::setSink(HostSink sink) { reinterpret_cast<HostBlock *>(host_.get())->ctx.sink = std::move(sink); }
+
+void PluginInstanceBase::fail(const std::string &what, int32_t code, const char *message) const {
+    std::string msg = std::string(kindName(record_.kind)) + " plugin '" + record_.name + "' (" + record_.path + "): " + what +
+                      " failed (" + resultName(code) + ")";
+    if (message && *message) msg += ": " + std::string(message);
+    throw PluginError(msg, code);
+}
+
+namespace {
+
+// Checks an image a plugin handed back; returns "" when fine, else what is wrong.
+std::string checkImage(const binocle_image &im, const char *what) {
+    std::ostringstream os;
+    const int bpp = [&] {
+        switch (im.format) {
+        case BINOCLE_PIXEL_GRAY8: return 1;
+        case BINOCLE_PIXEL_GRAY16: return 2;
+        case BINOCLE_PIXEL_BGR8:
+        case BINOCLE_PIXEL_RGB8: return 3;
+        case BINOCLE_PIXEL_FLOAT32: return 4;
+        default: return 0;
+        }
+    }();
+    if (bpp == 0) os << what << " has unknown pixel format " << im.format;
+    else if (im.width <= 0 || im.height <= 0 || im.width > 65536 || im.height > 65536)
+        os << what << " has an impossible size " << im.width << "x" << im.height;
+    else if (static_cast<int64_t>(im.stride_bytes) < static_cast<int64_t>(im.width) * bpp)
+        os << what << " has stride " << im.stride_bytes << " bytes, less than width " << im.width << " x " << bpp << " bytes";
+    else if (!im.data)
+        os << what << " has no pixel data (NULL)";
+    return os.str();
+}
+
+int cvType(int32_t format) {
+    switch (format) {
+    case BINOCLE_PIXEL_GRAY8: return CV_8UC1;
+    case BINOCLE_PIXEL_GRAY16: return CV_16UC1;
+    case BINOCLE_PIXEL_BGR8:
+    case BINOCLE_PIXEL_RGB8: return CV_8UC3;
+    case BINOCLE_PIXEL_FLOAT32: return CV_32FC1;
+    default: return -1;
+    }
+}
+
+cv::Mat view(const binocle_image &im) {
+    return cv::Mat(im.height, im.width, cvType(im.format), im.data, static_cast<size_t>(im.stride_bytes));
+}
+
+binocle_image wrap(const cv::Mat &m, int32_t format) {
+    binocle_image im{};
+    im.width = m.cols;
+    im.height = m.rows;
+    im.stride_bytes = static_cast<int32_t>(m.step[0]);
+    im.format = format;
+    im.data = m.data;
+    return im;
+}
+
+int32_t formatOf(const cv::Mat &m) {
+    switch (m.type()) {
+    case CV_8UC1: return BINOCLE_PIXEL_GRAY8;
+    case CV_16UC1: return BINOCLE_PIXEL_GRAY16;
+    case CV_8UC3: return BINOCLE_PIXEL_BGR8;
+    case CV_32FC1: return BINOCLE_PIXEL_FLOAT32;
+    default: throw Error("image type " + std::to_string(m.type()) + " cannot cross the plugin ABI");
+    }
+}
+
+} // namespace
+
+// ---- LentFrame ---------------------------------------------------------------------------------
+
+LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_source_api *api, binocle_source *src,
+                     const binocle_stereo_frame &f)
+    : keep_(std::move(keep)), api_(api), src_(src), frame_(f) {}
+
+LentFrame::~LentFrame() {
+    try {
+        api_->release_frame(src_, frame_.frame_id);
+    } catch (...) {
+    }
+}
+
+cv::Mat LentFrame::left() const { return view(frame_.left); }
+cv::Mat LentFrame::right() const { return view(frame_.right); }
+
+cv::Mat LentFrame::extra(const std::string &name) const {
+    for (int32_t i = 0; i < frame_.extra_count; ++i)
+        if (frame_.extras[i].name && name == frame_.extras[i].name) return view(frame_.extras[i].image);
+    return {};
+}
+
+// ---- Source ------------------------------------------------------------------------------------
+
+Source::Source(const PluginRecord &record, const ParamValues &params)
+    : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_source_api *>(record.table)) {
+    binocle_source *h = nullptr;
+    int32_t rc = api_->create(params.data(), params.size(), host_.get(), &h);
+    if (rc != BINOCLE_OK || !h) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
+    // The handle outlives this object while frames are lent (each LentFrame holds it),
+    // and keeps the library and the host block alive in turn.
+    auto lib = record.library;
+    auto api = api_;
+    auto hostBlock = host_;
+    handle_ = std::shared_ptr<binocle_source>(h, [api, lib, hostBlock](binocle_source *p) {
+        try {
+            api->destroy(p);
+        } catch (...) {
+        }
+    });
+}
+
+Source::~Source() {
+    if (handle_ && api_->stop) {
+        try {
+            api_->stop(handle_.get());
+        } catch (...) {
+        }
+    }
+}
+
+void Source::start() {
+    if (!api_->start) return;
+    int32_t rc = api_->start(handle_.get());
+    if (rc != BINOCLE_OK) fail("start", rc, api_->last_error(handle_.get()));
+}
+
+void Source::stop() {
+    if (!api_->stop) return;
+    int32_t rc = api_->stop(handle_.get());
+    if (rc != BINOCLE_OK) fail("stop", rc, api_->last_error(handle_.get()));
+}
+
+std::unique_ptr<LentFrame> Source::grab(int32_t timeout_ms) {
+    binocle_stereo_frame f{};
+    f.struct_size = sizeof(f);
+    int32_t rc = api_->grab(handle_.get(), timeout_ms, &f);
+    if (rc == BINOCLE_ERR_END_OF_STREAM) return nullptr;
+    if (rc != BINOCLE_OK) fail("grab", rc, api_->last_error(handle_.get()));
+    // From here the frame is lent: any refusal below still gives it back.
+    auto lent = std::make_unique<LentFrame>(handle_, api_, handle_.get(), f);
+    std::string bad = checkImage(f.left, "left image");
+    if (bad.empty()) bad = checkImage(f.right, "right image");
+    if (bad.empty() && (f.left.width != f.right.width || f.left.height != f.right.height || f.left.format != f.right.format))
+        bad = "left and right images differ: " + std::to_string(f.left.width) + "x" + std::to_string(f.left.height) +
+              " format " + std::to_string(f.left.format) + " vs " + std::to_string(f.right.width) + "x" +
+              std::to_string(f.right.height) + " format " + std::to_string(f.right.format);
+    if (bad.empty() && (f.left.format == BINOCLE_PIXEL_FLOAT32 || f.left.format == BINOCLE_PIXEL_GRAY16))
+        bad = "left/right images must be GRAY8, BGR8 or RGB8";
+    if (bad.empty() && (f.extra_count < 0 || f.extra_count > 64 || (f.extra_count > 0 && !f.extras)))
+        bad = "garbage extra plane count " + std::to_string(f.extra_count);
+    for (int32_t i = 0; bad.empty() && i < f.extra_count; ++i) {
+        std::string name = f.extras[i].name ? f.extras[i].name : "(unnamed)";
+        bad = checkImage(f.extras[i].image, ("extra plane '" + name + "'").c_str());
+    }
+    if (!bad.empty()) fail("grab", BINOCLE_ERR_INTERNAL, ("returned an invalid frame: " + bad).c_str());
+    return lent;
+}
+
+std::string Source::calibration() {
+    if (!api_->calibration) return {};
+    const char *yaml = nullptr;
+    int32_t rc = api_->calibration(handle_.get(), &yaml);
+    if (rc != BINOCLE_OK) fail("calibration", rc, api_->last_error(handle_.get()));
+    return yaml ? yaml : "";
+}
+
+std::string Source::statistics() {
+    if (!api_->statistics) return {};
+    const char *yaml = nullptr;
+    int32_t rc = api_->statistics(handle_.get(), &yaml);
+    if (rc != BINOCLE_OK) fail("statistics", rc, api_->last_error(handle_.get()));
+    return yaml ? yaml : "";
+}
+
+std::string Source::enumerateDevices(const PluginRecord &record) {
+    auto api = reinterpret_cast<const binocle_source_api *>(record.table);
+    if (!api->enumerate_devices) return "[]";
+    HostBlock block{};
+    block.ctx.plugin = record.name;
+    block.host.struct_size = sizeof(binocle_host);
+    block.host.context = &block.ctx;
+    block.host.log = &hostLog;
+    block.host.report_metric = &hostMetric;
+    block.host.report_text = &hostText;
+    const char *yaml = nullptr;
+    int32_t rc = api->enumerate_devices(&block.host, &yaml);
+    if (rc != BINOCLE_OK) {
+        const char *m = api->last_error(nullptr);
+        throw PluginError("source plugin '" + record.name + "' (" + record.path + "): enumerate_devices failed (" +
+                              resultName(rc) + ")" + (m && *m ? ": " + std::string(m) : ""),
+                          rc);
+    }
+    return yaml ? yaml : "[]";
+}
+
+// ---- Matcher -----------------------------------------------------------------------------------
+
+Matcher::Matcher(const PluginRecord &record, const ParamValues &params)
+    : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_matcher_api *>(record.table)) {
+    int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
+    if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
+}
+
+Matcher::~Matcher() {
+    if (handle_) api_->destroy(handle_);
+}
+
+cv::Mat Matcher::compute(const cv::Mat &left, const cv::Mat &right) {
+    if (left.size() != right.size() || left.type() != right.type())
+        throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
+    cv::Mat disparity(left.size(), CV_32F, cv::Scalar(BINOCLE_INVALID_DISPARITY));
+    binocle_image l = wrap(left, formatOf(left)), r = wrap(right, formatOf(right));
+    binocle_image d = wrap(disparity, BINOCLE_PIXEL_FLOAT32);
+    const binocle_image expected = d;
+    int32_t rc = api_->compute(handle_, &l, &r, &d);
+    if (rc != BINOCLE_OK) fail("compute", rc, api_->last_error(handle_));
+    if (d.data != expected.data || d.width != expected.width || d.height != expected.height || d.format != expected.format ||
+        d.stride_bytes != expected.stride_bytes)
+        fail("compute", BINOCLE_ERR_INTERNAL, "changed the host's disparity image description instead of writing into it");
+    return disparity;
+}
+
+std::pair<int32_t, int32_t> Matcher::disparityRange() {
+    int32_t mn = 0, num = 0;
+    if (!api_->disparity_range) return {0, 0};
+    int32_t rc = api_->disparity_range(handle_, &mn, &num);
+    if (rc != BINOCLE_OK) fail("disparity_range", rc, api_->last_error(handle_));
+    return {mn, num};
+}
+
+// ---- CloudTransform ------------------------------------------------------------------------------
+
+CloudTransform::CloudTransform(const PluginRecord &record, const ParamValues &params)
+    : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_cloud_transform_api *>(record.table)) {
+    int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
+    if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
+}
+
+CloudTransform::~CloudTransform() {
+    if (handle_) api_->destroy(handle_);
+}
+
+void CloudTransform::apply(binocle_cloud &cloud) {
+    const binocle_cloud before = cloud;
+    int32_t rc = api_->apply(handle_, &cloud);
+    if (rc != BINOCLE_OK) fail("apply", rc, api_->last_error(handle_));
+    if (cloud.count < 0 || cloud.count > before.count || cloud.xyz != before.xyz || cloud.rgb != before.rgb ||
+        cloud.pixel != before.pixel || (cloud.frame != BINOCLE_FRAME_CAMERA && cloud.frame != BINOCLE_FRAME_GROUND)) {
+        const int64_t count = cloud.count;
+        cloud = before;
+        fail("apply", BINOCLE_ERR_INTERNAL,
+             ("returned a garbage cloud (count " + std::to_string(count) + " of " + std::to_string(before.count) +
+              ", arrays or frame changed)")
+                 .c_str());
+    }
+}
+
+// ---- Evaluator -----------------------------------------------------------------------------------
+
+Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink)
+    : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_evaluator_api *>(record.table)) {
+    setSink(std::move(sink));
+    int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
+    if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
+}
+
+Evaluator::~Evaluator() {
+    if (handle_) api_->destroy(handle_);
+}
+
+void Evaluator::evaluate(const binocle_eval_input &input) {
+    int32_t rc = api_->evaluate(handle_, &input);
+    if (rc != BINOCLE_OK) fail("evaluate", rc, api_->last_error(handle_));
+}
+
+void Evaluator::finish() {
+    if (!api_->finish) return;
+    int32_t rc = api_->finish(handle_);
+    if (rc != BINOCLE_OK) fail("finish", rc, api_->last_error(handle_));
+}
+
+} // namespace binocle

@@ -1,0 +1,258 @@
+// SPDX-License-Identifier: MIT
+// The pipeline: acquire, rectify, match, triangulate, transform, evaluate, write.
+#include "pipeline/pipeline.hpp"
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/image_io.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace binocle {
+
+Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
+    source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
+    matcher_ = std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params);
+    for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
+    for (const auto &e : rig.evaluators) {
+        auto slot = std::make_unique<EvaluatorSlot>();
+        slot->name = e.plugin;
+        EvaluatorSlot *raw = slot.get();
+        HostSink sink;
+        sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
+            if (!raw->target) return;
+            raw->target->set(name, value);
+            if (!unit.empty()) raw->target->set(name + "_unit", unit);
+        };
+        sink.text = [raw](const std::string &name, const std::string &text) {
+            if (raw->target) raw->target->set(name, text);
+        };
+        slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
+        evaluators_.push_back(std::move(slot));
+    }
+}
+
+Pipeline::~Pipeline() = default;
+
+void Pipeline::prepareCalibration(const cv::Size &imageSize) {
+    if (rig_.calibration_file) {
+        calibration_ = StereoCalibration::load(*rig_.calibration_file);
+        calibrationYaml_ = readTextFile(*rig_.calibration_file);
+    } else {
+        calibrationYaml_ = source_->calibration();
+        if (calibrationYaml_.empty())
+            throw Error(rig_.file + ": no calibration: the rig names no 'calibration:' file and source plugin '" +
+                        rig_.source.plugin + "' publishes none (run `binocle calibrate`, or add calibration: FILE)");
+        calibration_ = StereoCalibration::fromYaml(calibrationYaml_, "calibration published by source '" + rig_.source.plugin + "'");
+    }
+    // Geometry check before the first frame: a calibration made for another image size
+    // or with a baseline of the wrong sign gives a collapsed cloud or negative disparities.
+    const std::string origin = rig_.calibration_file ? *rig_.calibration_file : "the calibration of source '" + rig_.source.plugin + "'";
+    if (calibration_.image_size != imageSize)
+        throw Error(origin + ": calibration is for " + std::to_string(calibration_.image_size.width) + "x" +
+                    std::to_string(calibration_.image_size.height) + " images, but the source delivers " +
+                    std::to_string(imageSize.width) + "x" + std::to_string(imageSize.height));
+    if (calibration_.T.at<double>(0) >= 0)
+        throw Error(origin + ": T.x = " + std::to_string(calibration_.T.at<double>(0)) +
+                    " mm: the right camera must be to the right of the left one (T.x < 0, x_r = R x_l + T); "
+                    "left and right are probably swapped");
+    if (!calibration_.rectified) {
+        cv::initUndistortRectifyMap(calibration_.M1, calibration_.D1, calibration_.R1, calibration_.P1, imageSize, CV_32FC1,
+                                    map1x_, map1y_);
+        cv::initUndistortRectifyMap(calibration_.M2, calibration_.D2, calibration_.R2, calibration_.P2, imageSize, CV_32FC1,
+                                    map2x_, map2y_);
+    }
+    calibrationReady_ = true;
+}
+
+FrameResult Pipeline::process(const LentFrame &frame) {
+    const auto t0 = std::chrono::steady_clock::now();
+    FrameResult r;
+    r.sequence = frame.raw().sequence;
+    cv::Mat left = frame.left(), right = frame.right();
+    if (!calibrationReady_) prepareCalibration(left.size());
+    if (calibration_.rectified) {
+        r.rectified_left = left; // zero-copy: the frame stays lent until we return
+        r.rectified_right = right;
+    } else {
+        cv::remap(left, r.rectified_left, map1x_, map1y_, cv::INTER_LINEAR);
+        cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
+    }
+    r.disparity = matcher_->compute(r.rectified_left, r.rectified_right);
+    r.cloud = cloudFromDisparity(r.disparity, calibration_, r.rectified_left, rig_.outputs.max_range_mm);
+    for (auto &t : transforms_) {
+        binocle_cloud view = r.cloud.view();
+        t->apply(view);
+        r.cloud.adopt(view);
+    }
+    r.metrics = Json::object();
+    if (!evaluators_.empty()) {
+        binocle_image rl{}, rr{}, d{};
+        auto wrap = [](const cv::Mat &m, binocle_image &im) {
+            im.width = m.cols;
+            im.height = m.rows;
+            im.stride_bytes = static_cast<int32_t>(m.step[0]);
+            im.format = m.type() == CV_32F ? BINOCLE_PIXEL_FLOAT32 : m.channels() == 3 ? BINOCLE_PIXEL_BGR8 : BINOCLE_PIXEL_GRAY8;
+            im.data = m.data;
+        };
+        wrap(r.rectified_left, rl);
+        wrap(r.rectified_right, rr);
+        wrap(r.disparity, d);
+        binocle_cloud cloud = r.cloud.view();
+        binocle_eval_input in{};
+        in.struct_size = sizeof(in);
+        in.frame = &frame.raw();
+        in.rectified_left = &rl;
+        in.rectified_right = &rr;
+        in.disparity = &d;
+        in.cloud = &cloud;
+        in.calibration_yaml = calibrationYaml_.c_str();
+        in.rig_yaml = rig_.resolved_yaml.c_str();
+        in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
+        for (auto &slot : evaluators_) {
+            Json figures = Json::object();
+            slot->target = &figures;
+            try {
+                slot->evaluator->evaluate(in);
+            } catch (...) {
+                slot->target = nullptr;
+                throw;
+            }
+            slot->target = nullptr;
+            r.metrics.set(slot->name, std::move(figures));
+        }
+    }
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+}
+
+void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const {
+    char stem[32];
+    std::snprintf(stem, sizeof stem, "%06llu", static_cast<unsigned long long>(r.sequence));
+    const fs::path d(dir);
+    const auto &o = rig_.outputs;
+    if (o.disparity_png) writeDisparityPng16((d / ("disparity_" + std::string(stem) + ".png")).string(), r.disparity);
+    if (o.disparity_color) writeImage((d / ("disparity_color_" + std::string(stem) + ".png")).string(), colorizeDisparity(r.disparity));
+    if (o.disparity_pfm) writePfm((d / ("disparity_" + std::string(stem) + ".pfm")).string(), r.disparity);
+    if (o.rectified_png) {
+        writeImage((d / ("rectified_left_" + std::string(stem) + ".png")).string(), r.rectified_left);
+        writeImage((d / ("rectified_right_" + std::string(stem) + ".png")).string(), r.rectified_right);
+    }
+    if (o.cloud_ply) writePly((d / ("cloud_" + std::string(stem) + ".ply")).string(), r.cloud);
+}
+
+namespace {
+
+class Progress {
+public:
+    explicit Progress(bool enabled, int64_t total) : enabled_(enabled), total_(total), tty_(::isatty(2) != 0) {}
+    void update(int64_t done, double fps) {
+        if (!enabled_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (!tty_ && done > 1 && now - last_ < std::chrono::seconds(2)) return;
+        last_ = now;
+        char buf[128];
+        if (total_ > 0)
+            std::snprintf(buf, sizeof buf, "frame %lld/%lld  %.1f fps", static_cast<long long>(done), static_cast<long long>(total_), fps);
+        else
+            std::snprintf(buf, sizeof buf, "frame %lld  %.1f fps", static_cast<long long>(done), fps);
+        std::cerr << (tty_ ? "\r" : "") << buf << (tty_ ? "" : "\n") << std::flush;
+        printed_ = true;
+    }
+    ~Progress() {
+        if (printed_ && tty_) std::cerr << "\n";
+    }
+
+private:
+    bool enabled_;
+    int64_t total_;
+    bool tty_;
+    bool printed_ = false;
+    std::chrono::steady_clock::time_point last_{};
+};
+
+} // namespace
+
+Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
+    outDir_ = options.out_dir;
+    if (!outDir_.empty()) {
+        std::error_code ec;
+        fs::create_directories(outDir_, ec);
+        if (ec) throw Error("--out " + outDir_ + ": cannot create the folder: " + ec.message());
+    }
+    Json summary = Json::object();
+    summary.set("rig", rig_.file);
+    summary.set("name", rig_.name);
+    summary.set("source", rig_.source.plugin);
+    summary.set("matcher", rig_.matcher.plugin);
+    summary.set("units", Json::object().set("length", "mm").set("disparity", "px").set("disparity_png_scale", 256));
+    Json frames = Json::array();
+    const auto start = std::chrono::steady_clock::now();
+    int64_t count = 0;
+    std::string failure;
+    auto writeSummary = [&]() {
+        if (outDir_.empty()) return;
+        summary.set("frames", frames);
+        writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump());
+    };
+    try {
+        source_->start();
+        Progress progress(options.progress, options.max_frames);
+        while (options.max_frames < 0 || count < options.max_frames) {
+            std::unique_ptr<LentFrame> frame = source_->grab(options.grab_timeout_ms);
+            if (!frame) break;
+            FrameResult r = process(*frame);
+            if (!outDir_.empty()) writeOutputs(r, outDir_);
+            const double valid = r.disparity.empty() ? 0.0 : static_cast<double>(cv::countNonZero(r.disparity > 0)) / r.disparity.total();
+            Json f = Json::object();
+            f.set("sequence", r.sequence);
+            f.set("valid_pixel_ratio", valid);
+            f.set("points", static_cast<uint64_t>(r.cloud.size()));
+            f.set("seconds", r.seconds);
+            f.set("metrics", r.metrics);
+            frames.push(std::move(f));
+            if (onFrame) onFrame(r);
+            ++count;
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            progress.update(count, elapsed > 0 ? count / elapsed : 0.0);
+        }
+        Json totals = Json::object();
+        for (auto &slot : evaluators_) {
+            Json figures = Json::object();
+            slot->target = &figures;
+            slot->evaluator->finish();
+            slot->target = nullptr;
+            totals.set(slot->name, std::move(figures));
+        }
+        summary.set("metrics", totals);
+        const std::string stats = source_->statistics();
+        if (!stats.empty()) summary.set("source_statistics", stats);
+    } catch (const std::exception &e) {
+        failure = e.what();
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary.set("frame_count", count);
+    summary.set("seconds", elapsed);
+    summary.set("status", failure.empty() ? "ok" : "failed");
+    if (!failure.empty()) summary.set("error", failure);
+    if (calibrationReady_) {
+        summary.set("calibration", Json::object()
+                                       .set("baseline_mm", calibration_.baselineMm())
+                                       .set("focal_length_px", calibration_.focalLengthPx())
+                                       .set("image_width", calibration_.image_size.width)
+                                       .set("image_height", calibration_.image_size.height));
+    }
+    writeSummary();
+    if (!failure.empty()) throw Error(failure);
+    return summary;
+}
+
+} // namespace binocle

@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// The pipeline of METHOD.md (Fig. 2b): acquire -> rectify -> disparity -> cloud in
+// camera coordinates -> cloud transforms (ground frame, Eq. 1) -> evaluators -> outputs.
+#pragma once
+
+#include "config/rig_config.hpp"
+#include "core/calibration.hpp"
+#include "core/cloud.hpp"
+#include "core/json.hpp"
+#include "host/plugin_host.hpp"
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace binocle {
+
+struct RunOptions {
+    int64_t max_frames = -1;   // < 0: until the source ends
+    std::string out_dir;       // empty: write nothing
+    bool progress = true;      // a progress line on stderr
+    int32_t grab_timeout_ms = 5000;
+};
+
+// What one frame produced, for callers that want more than files (experiments, tests).
+struct FrameResult {
+    uint64_t sequence = 0;
+    cv::Mat rectified_left, rectified_right;
+    cv::Mat disparity; // CV_32F
+    Cloud cloud;       // after transforms
+    Json metrics;      // {evaluator: {metric: value}}
+    double seconds = 0;
+};
+
+class Pipeline {
+public:
+    Pipeline(const RigConfig &rig, const PluginHost &host);
+    ~Pipeline();
+
+    // Runs and returns the summary (also written as summary.json when out_dir is set).
+    // `onFrame` sees every frame's result before it is dropped.
+    Json run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame = {});
+
+    const StereoCalibration &calibration() const { return calibration_; }
+    Source &source() { return *source_; }
+
+private:
+    void prepareCalibration(const cv::Size &imageSize);
+    FrameResult process(const LentFrame &frame);
+    void writeOutputs(const FrameResult &r, const std::string &dir) const;
+
+    RigConfig rig_;
+    std::unique_ptr<Source> source_;
+    std::unique_ptr<Matcher> matcher_;
+    std::vector<std::unique_ptr<CloudTransform>> transforms_;
+    struct EvaluatorSlot {
+        std::string name;
+        std::unique_ptr<Evaluator> evaluator;
+        Json *target = nullptr; // where its figures go right now
+    };
+    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
+    StereoCalibration calibration_;
+    std::string calibrationYaml_;
+    bool calibrationReady_ = false;
+    cv::Mat map1x_, map1y_, map2x_, map2y_;
+    std::string outDir_;
+};
+
+} // namespace binocle
