@@ -1,0 +1,904 @@
+// SPDX-License-Identifier: MIT
+// replay: a StereoSource that plays stereo pairs back from files: glob patterns,
+// Middlebury scenes, a KITTI tree or a folder written by `binocle record`.
+//
+// Read top to bottom: settings, what a layout yields (a list of frames and a
+// calibration), the four layouts and their detection, the source itself, and the
+// registration line at the very end. The file formats are described in README.md.
+#include "replay_files.hpp"
+
+#include <binocle/plugin.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace binocle::replay {
+namespace {
+
+using sdk::Error;
+
+// ---- Settings ----------------------------------------------------------------------------
+
+std::vector<binocle_param_desc> parameterTable() {
+    using sdk::Param;
+    return {
+        Param::choice("layout", "auto", "auto|glob|middlebury|kitti|recording")
+            .help("how the files are laid out; auto: glob when left/right are set, else detected from folder"),
+        Param::path("left", "").help("glob layout: pattern of the left images, e.g. /data/run1/left_*.png"),
+        Param::path("right", "").help("glob layout: pattern of the right images, as many as the left ones"),
+        Param::path("ground_truth", "")
+            .help("glob layout: pattern of disparity images (16-bit PNG d*256, 8-bit PNG d, PFM), one per pair"),
+        Param::real("ground_truth_scale", "1").min(0)
+            .help("ground-truth disparities are multiplied by this after decoding (e.g. 0.5 for a half-size pair)"),
+        Param::path("folder", "")
+            .help("middlebury (a scene folder, a folder of scenes or a glob over scene folders), kitti or recording folder"),
+        Param::path("calibration", "")
+            .help("OpenCV FileStorage YAML calibration that replaces the one the layout provides"),
+        Param::boolean("loop", false).help("start again from the first frame after the last one"),
+        Param::integer("first_frame", "0").min(0).help("index of the first frame played, in the layout's order"),
+        Param::integer("max_frames", "0").min(0).help("play at most this many frames (0 = all)"),
+        Param::choice("color", "bgr", "gray|bgr").help("deliver BGR8 or GRAY8 images"),
+        Param::real("rate_hz", "0").min(0).unit("Hz")
+            .help("pace grab to this rate; 0 = as fast as possible (time stamps then use a nominal 30 Hz)"),
+    };
+}
+
+struct Settings {
+    std::string layout = "auto";
+    std::string left, right, groundTruth, folder, calibration;
+    double groundTruthScale = 1.0;
+    bool loop = false;
+    int64_t firstFrame = 0, maxFrames = 0;
+    bool gray = false;
+    double rateHz = 0.0;
+};
+
+std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
+
+// Settings absent from `p` keep their defaults: a host may pass only what the YAML set.
+Settings readSettings(const sdk::Params &p) {
+    Settings s;
+    auto text = [&](const char *name, std::string &out) {
+        if (p.has(name)) out = p.string(name);
+    };
+    // An unset PATH is empty whatever the host made of the empty default.
+    auto path = [&](const char *name, std::string &out) {
+        if (p.has(name) && p.isExplicit(name)) out = p.string(name);
+    };
+    text("layout", s.layout);
+    path("left", s.left);
+    path("right", s.right);
+    path("ground_truth", s.groundTruth);
+    path("folder", s.folder);
+    path("calibration", s.calibration);
+    if (p.has("ground_truth_scale")) s.groundTruthScale = p.real("ground_truth_scale");
+    if (p.has("loop")) s.loop = p.boolean("loop");
+    if (p.has("first_frame")) s.firstFrame = p.integer("first_frame");
+    if (p.has("max_frames")) s.maxFrames = p.integer("max_frames");
+    std::string color = "bgr";
+    text("color", color);
+    if (p.has("rate_hz")) s.rateHz = p.real("rate_hz");
+
+    auto refuse = [](const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what); };
+    const std::string layouts = "|auto|glob|middlebury|kitti|recording|";
+    if (s.layout.empty() || layouts.find("|" + s.layout + "|") == std::string::npos)
+        refuse("layout '" + s.layout + "': expected one of auto, glob, middlebury, kitti, recording");
+    if (color != "gray" && color != "bgr") refuse("color '" + color + "': expected gray or bgr");
+    s.gray = color == "gray";
+    if (!(s.groundTruthScale > 0) || !std::isfinite(s.groundTruthScale))
+        refuse("ground_truth_scale " + std::to_string(s.groundTruthScale) + ": expected a number > 0");
+    if (s.firstFrame < 0) refuse("first_frame " + std::to_string(s.firstFrame) + ": expected >= 0");
+    if (s.maxFrames < 0) refuse("max_frames " + std::to_string(s.maxFrames) + ": expected >= 0 (0 = all)");
+    if (!(s.rateHz >= 0) || !std::isfinite(s.rateHz))
+        refuse("rate_hz " + std::to_string(s.rateHz) + ": expected a number >= 0 (0 = as fast as possible)");
+    return s;
+}
+
+// ---- What a layout yields ----------------------------------------------------------------
+
+// One stereo pair on disk.
+struct FrameFiles {
+    fs::path left, right;
+    fs::path groundTruth; // empty: no ground truth for this pair
+    bool hasTimestamps = false;
+    int64_t timestampLeftNs = 0, timestampRightNs = 0;
+    // Layout-specific facts for the frame's metadata ("ndisp", "recorded_sequence" ...).
+    std::vector<std::pair<std::string, std::string>> facts;
+};
+
+struct Plan {
+    std::string layout;
+    std::vector<FrameFiles> frames;
+    std::string calibration; // FileStorage YAML text; empty when unknown
+    // Recording: the last frame may have been cut short; if it cannot be decoded the
+    // stream ends before it, with a warning, instead of failing.
+    bool lenientLastFrame = false;
+    size_t droppedAtEnd = 0; // frames of a cut recording left out
+};
+
+// A rectified pinhole pair: the calibration the Middlebury and KITTI layouts know.
+struct PinholePair {
+    cv::Size imageSize;
+    cv::Matx33d M1, M2; // intrinsics; M2 keeps its own cx (Middlebury doffs)
+    double baselineMm = 0;
+
+    double focalLengthPx() const { return M1(0, 0); }
+
+    // The format of framework/core/calibration.hpp, rectification included, so that a
+    // reader needs not recompute it (which would equalise cx and lose doffs).
+    std::string toYaml() const {
+        const double f = M1(0, 0), cx0 = M1(0, 2), cy = M1(1, 2), cx1 = M2(0, 2);
+        cv::Mat P1 = (cv::Mat_<double>(3, 4) << f, 0, cx0, 0, 0, M1(1, 1), cy, 0, 0, 0, 1, 0);
+        cv::Mat P2 = (cv::Mat_<double>(3, 4) << M2(0, 0), 0, cx1, -M2(0, 0) * baselineMm, 0, M2(1, 1), M2(1, 2), 0, 0,
+                      0, 1, 0);
+        // OpenCV's Q for Tx = -B: W = (d + cx1 - cx0) / B, so Z = f B / (d + doffs).
+        cv::Mat Q = (cv::Mat_<double>(4, 4) << 1, 0, 0, -cx0, 0, 1, 0, -cy, 0, 0, 0, f, 0, 0, 1.0 / baselineMm,
+                     (cx1 - cx0) / baselineMm);
+        cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+        fs << "image_width" << imageSize.width << "image_height" << imageSize.height;
+        fs << "M1" << cv::Mat(M1) << "D1" << cv::Mat::zeros(1, 5, CV_64F);
+        fs << "M2" << cv::Mat(M2) << "D2" << cv::Mat::zeros(1, 5, CV_64F);
+        fs << "R" << cv::Mat::eye(3, 3, CV_64F) << "T" << (cv::Mat_<double>(3, 1) << -baselineMm, 0, 0);
+        fs << "rectified" << 1;
+        fs << "R1" << cv::Mat::eye(3, 3, CV_64F) << "R2" << cv::Mat::eye(3, 3, CV_64F);
+        fs << "P1" << P1 << "P2" << P2 << "Q" << Q;
+        fs << "baseline_mm" << baselineMm << "focal_length_px" << f;
+        return fs.releaseAndGetString();
+    }
+
+    void addFacts(FrameFiles &frame) const {
+        std::ostringstream f, b;
+        f.precision(10);
+        b.precision(10);
+        f << focalLengthPx();
+        b << baselineMm;
+        frame.facts.emplace_back("focal_length_px", f.str());
+        frame.facts.emplace_back("baseline_mm", b.str());
+    }
+
+    bool sameAs(const PinholePair &o) const {
+        auto close = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(a)); };
+        return imageSize == o.imageSize && close(focalLengthPx(), o.focalLengthPx()) &&
+               close(baselineMm, o.baselineMm) && close(M1(0, 2), o.M1(0, 2)) && close(M2(0, 2), o.M2(0, 2)) &&
+               close(M1(1, 2), o.M1(1, 2));
+    }
+};
+
+// Several scenes may come with several calibrations: the first one is published, each
+// frame's metadata carries its own focal length and baseline, and a difference is said.
+std::string publishFirst(const std::vector<std::pair<fs::path, PinholePair>> &calibrations, const sdk::Host &host) {
+    if (calibrations.empty()) return {};
+    for (const auto &c : calibrations)
+        if (!c.second.sameAs(calibrations.front().second)) {
+            host.warning("replay: calibrations differ between frames (" + inQuotes(calibrations.front().first) + " vs " +
+                         inQuotes(c.first) + "); the first one is published, each frame's metadata carries its own " +
+                         "focal_length_px and baseline_mm");
+            break;
+        }
+    return calibrations.front().second.toYaml();
+}
+
+std::string readText(const fs::path &path, const std::string &what) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read " + what + " " + inQuotes(path));
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+cv::Size imageSizeOf(const fs::path &path) {
+    cv::Mat m = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    if (m.empty()) throw Error(BINOCLE_ERR_IO, "replay: cannot decode image " + inQuotes(path));
+    return m.size();
+}
+
+bool isImageFile(const fs::path &p) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    static const std::vector<std::string> known{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".pfm", ".webp"};
+    return std::find(known.begin(), known.end(), ext) != known.end();
+}
+
+std::vector<double> numbersIn(std::string text) {
+    for (char &c : text)
+        if (c == '[' || c == ']' || c == ';' || c == ',') c = ' ';
+    std::istringstream in(text);
+    std::vector<double> out;
+    double v;
+    while (in >> v) out.push_back(v);
+    if (!in.eof()) out.clear(); // something that is not a number
+    return out;
+}
+
+// ---- glob layout ---------------------------------------------------------------------------
+
+std::vector<fs::path> globFiles(const std::string &setting, const std::string &pattern) {
+    std::vector<fs::path> files;
+    for (fs::path &p : globPaths(pattern))
+        if (fs::is_regular_file(p)) files.push_back(std::move(p));
+    if (files.empty())
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: " + setting + " pattern '" + pattern + "' matched no file");
+    return files;
+}
+
+Plan planGlob(const Settings &s) {
+    if (s.left.empty() || s.right.empty())
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                    "replay: the glob layout needs both `left` and `right` patterns (left '" + s.left + "', right '" +
+                        s.right + "')");
+    Plan plan;
+    plan.layout = "glob";
+    const auto lefts = globFiles("left", s.left);
+    const auto rights = globFiles("right", s.right);
+    if (lefts.size() != rights.size())
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: left pattern '" + s.left + "' matched " +
+                                                      std::to_string(lefts.size()) + " files but right pattern '" +
+                                                      s.right + "' matched " + std::to_string(rights.size()) +
+                                                      "; expected as many right images as left ones");
+    std::vector<fs::path> truths;
+    if (!s.groundTruth.empty()) {
+        truths = globFiles("ground_truth", s.groundTruth);
+        if (truths.size() != lefts.size())
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground_truth pattern '" + s.groundTruth + "' matched " +
+                                                          std::to_string(truths.size()) + " files but left pattern '" +
+                                                          s.left + "' matched " + std::to_string(lefts.size()) +
+                                                          "; expected one ground truth per pair");
+    }
+    for (size_t i = 0; i < lefts.size(); ++i) {
+        FrameFiles f;
+        f.left = lefts[i];
+        f.right = rights[i];
+        if (!truths.empty()) f.groundTruth = truths[i];
+        plan.frames.push_back(std::move(f));
+    }
+    return plan;
+}
+
+// ---- middlebury layout -------------------------------------------------------------------
+// A scene folder: im0.png (left), im1.png (right), calib.txt, disp0.pfm or disp0GT.pfm.
+
+bool isMiddleburyScene(const fs::path &folder) { return fs::is_regular_file(folder / "im0.png"); }
+
+// calib.txt: lines key=value; cam0=[f 0 cx; 0 f cy; 0 0 1], cam1, doffs, baseline (mm),
+// width, height, ndisp ...
+PinholePair readMiddleburyCalib(const fs::path &file, const fs::path &leftImage,
+                                std::vector<std::pair<std::string, std::string>> &facts) {
+    std::ifstream in(file);
+    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read Middlebury calibration " + inQuotes(file));
+    std::map<std::string, std::pair<std::vector<double>, int>> values; // key -> numbers, line
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        auto eq = line.find('=');
+        if (line.find_first_not_of(" \t") == std::string::npos) continue;
+        if (eq == std::string::npos)
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + file.string() + ":" + std::to_string(number) + ": '" +
+                                                          line + "': expected key=value");
+        std::string key = line.substr(0, eq);
+        key.erase(key.find_last_not_of(" \t") + 1);
+        key.erase(0, key.find_first_not_of(" \t"));
+        values[key] = {numbersIn(line.substr(eq + 1)), number};
+    }
+    auto numbers = [&](const std::string &key, size_t count, bool required) -> std::vector<double> {
+        auto it = values.find(key);
+        if (it == values.end()) {
+            if (required)
+                throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                            "replay: Middlebury calibration " + inQuotes(file) + " has no '" + key + "' line");
+            return {};
+        }
+        if (it->second.first.size() != count)
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + file.string() + ":" + std::to_string(it->second.second) +
+                                                          ": '" + key + "' holds " + std::to_string(it->second.first.size()) +
+                                                          " numbers; expected " + std::to_string(count));
+        return it->second.first;
+    };
+    const auto cam0 = numbers("cam0", 9, true);
+    const auto cam1 = numbers("cam1", 9, true);
+    const auto baseline = numbers("baseline", 1, true);
+    const auto width = numbers("width", 1, false);
+    const auto height = numbers("height", 1, false);
+    if (!(baseline[0] > 0) || !(cam0[0] > 0) || !(cam1[0] > 0))
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: Middlebury calibration " + inQuotes(file) +
+                                                      ": expected a positive baseline and focal lengths");
+    PinholePair pair;
+    pair.M1 = cv::Matx33d(cam0.data());
+    pair.M2 = cv::Matx33d(cam1.data());
+    pair.baselineMm = baseline[0];
+    pair.imageSize = !width.empty() && !height.empty()
+                         ? cv::Size(static_cast<int>(width[0]), static_cast<int>(height[0]))
+                         : imageSizeOf(leftImage);
+    for (const char *key : {"ndisp", "doffs", "vmin", "vmax"}) {
+        auto v = numbers(key, 1, false);
+        if (!v.empty()) {
+            std::ostringstream s;
+            s << v[0];
+            facts.emplace_back(key, s.str());
+        }
+    }
+    return pair;
+}
+
+std::vector<fs::path> middleburyScenes(const std::string &folder) {
+    std::vector<fs::path> scenes;
+    if (hasWildcard(folder)) {
+        for (fs::path &p : globPaths(folder))
+            if (fs::is_directory(p)) scenes.push_back(std::move(p));
+        if (scenes.empty())
+            throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder pattern '" + folder + "' matched no folder");
+        for (const fs::path &p : scenes)
+            if (!isMiddleburyScene(p))
+                throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder pattern '" + folder + "' matched " + inQuotes(p) +
+                                                       ", which holds no im0.png; expected Middlebury scene folders");
+        return scenes;
+    }
+    if (!fs::is_directory(folder))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder '" + folder + "' does not exist or is not a folder");
+    if (isMiddleburyScene(folder)) return {fs::path(folder)};
+    for (fs::path &p : listFolder(folder, true))
+        if (isMiddleburyScene(p)) scenes.push_back(std::move(p));
+    if (scenes.empty())
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder '" + folder +
+                                               "' holds no im0.png, nor any sub-folder that does; expected a Middlebury scene");
+    return scenes;
+}
+
+Plan planMiddlebury(const Settings &s, const sdk::Host &host) {
+    Plan plan;
+    plan.layout = "middlebury";
+    std::vector<std::pair<fs::path, PinholePair>> calibrations;
+    for (const fs::path &scene : middleburyScenes(s.folder)) {
+        FrameFiles f;
+        f.left = scene / "im0.png";
+        f.right = scene / "im1.png";
+        if (!fs::is_regular_file(f.right))
+            throw Error(BINOCLE_ERR_NOT_FOUND, "replay: Middlebury scene " + inQuotes(scene) + " has im0.png but no im1.png");
+        for (const char *name : {"disp0.pfm", "disp0GT.pfm"})
+            if (f.groundTruth.empty() && fs::is_regular_file(scene / name)) f.groundTruth = scene / name;
+        f.facts.emplace_back("scene", scene.filename().string());
+        const fs::path calib = scene / "calib.txt";
+        if (fs::is_regular_file(calib)) {
+            PinholePair pair = readMiddleburyCalib(calib, f.left, f.facts);
+            pair.addFacts(f);
+            calibrations.emplace_back(calib, pair);
+        } else if (s.calibration.empty()) {
+            host.warning("replay: Middlebury scene " + inQuotes(scene) + " has no calib.txt; it brings no calibration");
+        }
+        plan.frames.push_back(std::move(f));
+    }
+    plan.calibration = publishFirst(calibrations, host);
+    return plan;
+}
+
+// ---- kitti layout --------------------------------------------------------------------------
+// KITTI 2015 (image_2/, image_3/, disp_occ_0/, disp_noc_0/) or 2012 (image_0/, image_1/,
+// disp_occ/, disp_noc/); pairs matched by file name. Calibration from P2/P3
+// (P_rect_02/P_rect_03; P0/P1 for image_0/1) in calib_cam_to_cam.txt or calib*/ *.txt.
+
+struct KittiCameras {
+    std::string leftDir, rightDir;
+    int leftIndex = 2, rightIndex = 3;
+};
+
+bool kittiCameras(const fs::path &folder, KittiCameras &out) {
+    if (fs::is_directory(folder / "image_2") && fs::is_directory(folder / "image_3")) {
+        out = {"image_2", "image_3", 2, 3};
+        return true;
+    }
+    if (fs::is_directory(folder / "image_0") && fs::is_directory(folder / "image_1")) {
+        out = {"image_0", "image_1", 0, 1};
+        return true;
+    }
+    return false;
+}
+
+// Reads "KEY: numbers" lines; the projection of camera i is "P<i>" or "P_rect_0<i>".
+bool readKittiCalib(const fs::path &file, const KittiCameras &cams, const fs::path &leftImage, PinholePair &out) {
+    std::ifstream in(file);
+    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read KITTI calibration " + inQuotes(file));
+    std::map<std::string, std::vector<double>> values;
+    std::string line;
+    while (std::getline(in, line)) {
+        auto colon = line.find(':');
+        if (colon == std::string::npos) continue;
+        values[line.substr(0, colon)] = numbersIn(line.substr(colon + 1));
+    }
+    auto projection = [&](int i, cv::Matx34d &P) {
+        for (const std::string &key : {"P" + std::to_string(i), "P_rect_0" + std::to_string(i)}) {
+            auto it = values.find(key);
+            if (it == values.end()) continue;
+            if (it->second.size() != 12)
+                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: KITTI calibration " + inQuotes(file) + ": '" + key +
+                                                              "' holds " + std::to_string(it->second.size()) +
+                                                              " numbers; expected 12 (a 3x4 projection)");
+            P = cv::Matx34d(it->second.data());
+            return true;
+        }
+        return false;
+    };
+    cv::Matx34d PL, PR;
+    if (!projection(cams.leftIndex, PL) || !projection(cams.rightIndex, PR)) return false;
+    out.M1 = PL.get_minor<3, 3>(0, 0);
+    out.M2 = PR.get_minor<3, 3>(0, 0);
+    // P = K [I | t]: t = K^-1 P(:,3) in metres, relative to the rectified camera 0.
+    const cv::Vec3d tl = out.M1.inv() * cv::Vec3d(PL(0, 3), PL(1, 3), PL(2, 3));
+    const cv::Vec3d tr = out.M2.inv() * cv::Vec3d(PR(0, 3), PR(1, 3), PR(2, 3));
+    out.baselineMm = (tl[0] - tr[0]) * 1000.0;
+    if (!(out.baselineMm > 0) || !(out.M1(0, 0) > 0))
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: KITTI calibration " + inQuotes(file) +
+                                                      ": P matrices give a baseline of " + std::to_string(out.baselineMm) +
+                                                      " mm; expected the left camera left of the right one");
+    auto size = values.find("S_rect_0" + std::to_string(cams.leftIndex));
+    out.imageSize = size != values.end() && size->second.size() == 2
+                        ? cv::Size(static_cast<int>(size->second[0]), static_cast<int>(size->second[1]))
+                        : imageSizeOf(leftImage);
+    return true;
+}
+
+std::vector<fs::path> kittiCalibFiles(const fs::path &folder) {
+    if (fs::is_regular_file(folder / "calib_cam_to_cam.txt")) return {folder / "calib_cam_to_cam.txt"};
+    for (const char *dir : {"calib_cam_to_cam", "calib"}) {
+        std::vector<fs::path> files;
+        for (fs::path &p : listFolder(folder / dir, false))
+            if (p.extension() == ".txt") files.push_back(std::move(p));
+        if (!files.empty()) return files;
+    }
+    return {};
+}
+
+Plan planKitti(const Settings &s, const sdk::Host &host) {
+    const fs::path folder = s.folder;
+    if (!fs::is_directory(folder))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
+    KittiCameras cams;
+    if (!kittiCameras(folder, cams))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) +
+                                              " holds neither image_2/ and image_3/ nor image_0/ and image_1/; expected a KITTI tree");
+    fs::path truthDir;
+    for (const char *dir : {"disp_occ_0", "disp_noc_0", "disp_occ", "disp_noc"})
+        if (truthDir.empty() && fs::is_directory(folder / dir)) truthDir = folder / dir;
+
+    Plan plan;
+    plan.layout = "kitti";
+    for (const fs::path &left : listFolder(folder / cams.leftDir, false)) {
+        if (!isImageFile(left)) continue;
+        FrameFiles f;
+        f.left = left;
+        f.right = folder / cams.rightDir / left.filename();
+        if (!fs::is_regular_file(f.right))
+            throw Error(BINOCLE_ERR_NOT_FOUND, "replay: KITTI left image " + inQuotes(left) + " has no right image " +
+                                                   inQuotes(f.right));
+        if (!truthDir.empty() && fs::is_regular_file(truthDir / left.filename())) f.groundTruth = truthDir / left.filename();
+        plan.frames.push_back(std::move(f));
+    }
+    if (plan.frames.empty())
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: KITTI folder " + inQuotes(folder / cams.leftDir) + " holds no image");
+
+    // One calibration file for all, or one per frame named after its stem ("000000.txt"
+    // for "000000_10.png").
+    const auto calibFiles = kittiCalibFiles(folder);
+    std::map<std::string, std::pair<fs::path, PinholePair>> byStem;
+    for (const fs::path &file : calibFiles) {
+        PinholePair pair;
+        if (readKittiCalib(file, cams, plan.frames.front().left, pair))
+            byStem[file.stem().string()] = {file, pair};
+        else
+            host.warning("replay: KITTI calibration " + inQuotes(file) + " has no P" + std::to_string(cams.leftIndex) +
+                         "/P" + std::to_string(cams.rightIndex) + " lines; ignored");
+    }
+    std::vector<std::pair<fs::path, PinholePair>> used;
+    for (FrameFiles &f : plan.frames) {
+        const std::string name = f.left.stem().string();
+        auto it = byStem.find(name.substr(0, name.find('_')));
+        if (it == byStem.end() && byStem.size() == 1) it = byStem.begin();
+        if (it == byStem.end()) continue;
+        it->second.second.addFacts(f);
+        used.push_back(it->second);
+    }
+    if (calibFiles.empty() && s.calibration.empty())
+        host.info("replay: KITTI folder " + inQuotes(folder) + " holds no calibration; none is published");
+    plan.calibration = publishFirst(used, host);
+    return plan;
+}
+
+// ---- recording layout ------------------------------------------------------------------------
+// frames.csv (sequence,timestamp_left_ns,timestamp_right_ns,left,right; paths relative to
+// the folder), calibration.yml, rig.yaml. A recording cut short stays readable up to its
+// last complete frame.
+
+std::vector<std::string> splitCsv(const std::string &line) {
+    std::vector<std::string> fields;
+    std::string field;
+    std::istringstream in(line);
+    while (std::getline(in, field, ',')) fields.push_back(field);
+    if (!line.empty() && line.back() == ',') fields.emplace_back();
+    for (std::string &f : fields) {
+        f.erase(f.find_last_not_of(" \t") + 1);
+        f.erase(0, f.find_first_not_of(" \t"));
+    }
+    return fields;
+}
+
+bool parseInt64(const std::string &text, int64_t &out) {
+    if (text.empty()) return false;
+    char *end = nullptr;
+    errno = 0;
+    long long v = std::strtoll(text.c_str(), &end, 10);
+    if (errno != 0 || end != text.c_str() + text.size()) return false;
+    out = v;
+    return true;
+}
+
+Plan planRecording(const Settings &s, const sdk::Host &host) {
+    const fs::path folder = s.folder;
+    const fs::path csv = folder / "frames.csv";
+    if (!fs::is_directory(folder))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
+    if (!fs::is_regular_file(csv))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording folder " + inQuotes(folder) + " holds no frames.csv");
+    const std::string text = readText(csv, "recording index");
+
+    // Lines, each with its number and whether a newline ended it.
+    struct Line {
+        std::string text;
+        int number;
+        bool ended;
+    };
+    std::vector<Line> lines;
+    size_t pos = 0;
+    for (int number = 1; pos < text.size(); ++number) {
+        size_t eol = text.find('\n', pos);
+        Line l{text.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos), number, eol != std::string::npos};
+        if (!l.text.empty() && l.text.back() == '\r') l.text.pop_back();
+        if (l.text.find_first_not_of(" \t") != std::string::npos) lines.push_back(std::move(l));
+        pos = eol == std::string::npos ? text.size() : eol + 1;
+    }
+    const std::string where = csv.string();
+    if (lines.empty()) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + inQuotes(csv) + " is empty; expected a header line");
+
+    const std::vector<std::string> header = splitCsv(lines.front().text);
+    const char *required[] = {"sequence", "timestamp_left_ns", "timestamp_right_ns", "left", "right"};
+    size_t column[5];
+    for (int c = 0; c < 5; ++c) {
+        auto it = std::find(header.begin(), header.end(), required[c]);
+        if (it == header.end())
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                        "replay: " + where + ":" + std::to_string(lines.front().number) + ": header '" + lines.front().text +
+                            "' has no column '" + required[c] +
+                            "'; expected sequence,timestamp_left_ns,timestamp_right_ns,left,right");
+        column[c] = static_cast<size_t>(it - header.begin());
+    }
+
+    Plan plan;
+    plan.layout = "recording";
+    plan.lenientLastFrame = true;
+    std::vector<int> lineOf;
+    for (size_t i = 1; i < lines.size(); ++i) {
+        const Line &l = lines[i];
+        const bool last = i + 1 == lines.size();
+        const std::vector<std::string> fields = splitCsv(l.text);
+        std::string problem;
+        int64_t sequence = 0;
+        FrameFiles f;
+        if (fields.size() != header.size())
+            problem = std::to_string(fields.size()) + " fields; expected " + std::to_string(header.size());
+        else if (!parseInt64(fields[column[0]], sequence) || !parseInt64(fields[column[1]], f.timestampLeftNs) ||
+                 !parseInt64(fields[column[2]], f.timestampRightNs))
+            problem = "sequence and time stamps must be integers";
+        else if (fields[column[3]].empty() || fields[column[4]].empty())
+            problem = "empty image path";
+        if (!problem.empty()) {
+            if (last) { // the recorder was stopped while writing this line
+                host.warning("replay: " + where + ":" + std::to_string(l.number) + " is incomplete (" + problem +
+                             "): a recording cut short; it is ignored");
+                ++plan.droppedAtEnd;
+                break;
+            }
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                        "replay: " + where + ":" + std::to_string(l.number) + ": '" + l.text + "': " + problem);
+        }
+        f.hasTimestamps = true;
+        f.left = folder / fields[column[3]];
+        f.right = folder / fields[column[4]];
+        f.facts.emplace_back("recorded_sequence", std::to_string(sequence));
+        plan.frames.push_back(std::move(f));
+        lineOf.push_back(l.number);
+    }
+    // Images missing at the end: the recorder stopped before writing them.
+    while (!plan.frames.empty() &&
+           (!fs::is_regular_file(plan.frames.back().left) || !fs::is_regular_file(plan.frames.back().right))) {
+        const FrameFiles &f = plan.frames.back();
+        host.warning("replay: " + where + ":" + std::to_string(lineOf.back()) + " names " +
+                     inQuotes(fs::is_regular_file(f.left) ? f.right : f.left) +
+                     ", which does not exist: a recording cut short; the frame is ignored");
+        plan.frames.pop_back();
+        lineOf.pop_back();
+        ++plan.droppedAtEnd;
+    }
+    for (size_t i = 0; i < plan.frames.size(); ++i)
+        for (const fs::path *p : {&plan.frames[i].left, &plan.frames[i].right})
+            if (!fs::is_regular_file(*p))
+                throw Error(BINOCLE_ERR_NOT_FOUND, "replay: " + where + ":" + std::to_string(lineOf[i]) + " names " +
+                                                       inQuotes(*p) + ", which does not exist");
+    if (plan.frames.empty())
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording " + inQuotes(folder) + " holds no complete frame");
+
+    const fs::path calibration = folder / "calibration.yml";
+    if (fs::is_regular_file(calibration)) plan.calibration = readText(calibration, "calibration");
+    else if (s.calibration.empty())
+        host.warning("replay: recording " + inQuotes(folder) + " has no calibration.yml; it brings no calibration");
+    return plan;
+}
+
+// ---- Layout detection --------------------------------------------------------------------------
+
+std::string detectLayout(const Settings &s) {
+    if (!s.left.empty() || !s.right.empty()) return "glob";
+    if (s.folder.empty())
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                    "replay: nothing to replay: set `left` and `right` (glob patterns) or `folder` (a Middlebury, KITTI "
+                    "or recording folder)");
+    if (hasWildcard(s.folder)) return "middlebury";
+    const fs::path folder = s.folder;
+    if (!fs::is_directory(folder))
+        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
+    KittiCameras cams;
+    if (fs::is_regular_file(folder / "frames.csv")) return "recording";
+    if (isMiddleburyScene(folder)) return "middlebury";
+    if (kittiCameras(folder, cams)) return "kitti";
+    for (const fs::path &sub : listFolder(folder, true))
+        if (isMiddleburyScene(sub)) return "middlebury";
+    throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                "replay: folder " + inQuotes(folder) +
+                    " holds none of the known layouts: frames.csv (recording), im0.png and im1.png (middlebury, also "
+                    "in sub-folders), image_2/ and image_3/ (kitti); set `layout` or use `left`/`right` patterns");
+}
+
+Plan makePlan(const Settings &s, const sdk::Host &host) {
+    const std::string layout = s.layout == "auto" ? detectLayout(s) : s.layout;
+    const bool usesFolder = layout != "glob";
+    if (usesFolder && s.folder.empty())
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: layout " + layout + " needs `folder`");
+    if (usesFolder && (!s.left.empty() || !s.right.empty() || !s.groundTruth.empty()))
+        host.warning("replay: `left`, `right` and `ground_truth` are ignored by layout " + layout);
+    if (!usesFolder && !s.folder.empty()) host.warning("replay: `folder` is ignored by layout glob");
+
+    Plan plan = layout == "glob"         ? planGlob(s)
+                : layout == "middlebury" ? planMiddlebury(s, host)
+                : layout == "kitti"      ? planKitti(s, host)
+                                         : planRecording(s, host);
+
+    if (!s.calibration.empty()) {
+        const std::string text = readText(s.calibration, "calibration");
+        bool readable = false;
+        try {
+            cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+            readable = fs.isOpened() && !fs["M1"].empty() && !fs["T"].empty();
+        } catch (const cv::Exception &) {
+        }
+        if (!readable)
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: calibration " + inQuotes(s.calibration) +
+                                                          " is not an OpenCV FileStorage YAML calibration with M1 and T");
+        plan.calibration = text;
+    }
+
+    const auto available = static_cast<int64_t>(plan.frames.size());
+    if (s.firstFrame >= available)
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: first_frame " + std::to_string(s.firstFrame) +
+                                                      " is past the last frame: the " + plan.layout + " layout holds " +
+                                                      std::to_string(available) + " frames (0 .. " +
+                                                      std::to_string(available - 1) + ")");
+    plan.frames.erase(plan.frames.begin(), plan.frames.begin() + s.firstFrame);
+    if (s.maxFrames > 0 && static_cast<int64_t>(plan.frames.size()) > s.maxFrames) {
+        plan.frames.resize(static_cast<size_t>(s.maxFrames));
+        plan.lenientLastFrame = false; // the cut-short frame, if any, is not played
+    }
+    return plan;
+}
+
+// ---- The source --------------------------------------------------------------------------------
+
+// Pixels of one lent frame; lives until the host releases it.
+struct Pixels {
+    cv::Mat left, right, gtDisparity, gtValid;
+};
+
+binocle_image lend(const cv::Mat &m, int32_t format) {
+    return sdk::makeImage(m.cols, m.rows, format, m.data, static_cast<int32_t>(m.step[0]));
+}
+
+std::string sizeText(const cv::Mat &m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+constexpr double kNominalRateHz = 30.0; // time stamps when rate_hz is 0 and the files carry none
+
+class ReplaySource : public sdk::StereoSource {
+public:
+    static std::vector<binocle_param_desc> parameters() { return parameterTable(); }
+
+    ReplaySource(const sdk::Params &p, sdk::Host &host)
+        : host_(host), settings_(readSettings(p)), plan_(makePlan(settings_, host_)) {
+        periodNs_ = static_cast<int64_t>(std::llround(1e9 / (settings_.rateHz > 0 ? settings_.rateHz : kNominalRateHz)));
+        // A recording played in a loop keeps its time stamps increasing: each pass is
+        // shifted by the recording's span plus one mean frame interval.
+        const auto &frames = plan_.frames;
+        if (frames.front().hasTimestamps) {
+            const int64_t span = frames.back().timestampLeftNs - frames.front().timestampLeftNs;
+            passNs_ = frames.size() > 1 ? span + span / static_cast<int64_t>(frames.size() - 1) : periodNs_;
+            if (passNs_ <= 0) passNs_ = periodNs_ * static_cast<int64_t>(frames.size());
+        }
+        host_.info("replay: " + std::to_string(frames.size()) + (frames.size() == 1 ? " frame" : " frames") +
+                   ", layout " + plan_.layout +
+                   (plan_.calibration.empty() ? ", no calibration" : ", with calibration"));
+    }
+
+    void start() override {
+        started_ = true;
+        due_ = std::chrono::steady_clock::now();
+    }
+
+    void stop() override { started_ = false; }
+
+    std::unique_ptr<sdk::Frame> grab(int32_t timeout_ms) override {
+        if (!started_) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: grab before start (or after stop)");
+        for (;;) {
+            if (next_ >= plan_.frames.size()) {
+                if (!settings_.loop || plan_.frames.empty())
+                    throw Error(BINOCLE_ERR_END_OF_STREAM, "replay: end of the " + std::to_string(plan_.frames.size()) +
+                                                               " frames");
+                next_ = 0;
+                ++pass_;
+            }
+            waitUntilDue(timeout_ms);
+            auto pixels = std::make_shared<Pixels>();
+            const FrameFiles &files = plan_.frames[next_];
+            if (!decode(files, *pixels)) continue; // a cut-short last frame was dropped
+            return makeFrame(files, std::move(pixels));
+        }
+    }
+
+    std::string calibration() override { return plan_.calibration; }
+
+    std::string statistics() override {
+        YAML::Emitter out;
+        out << YAML::BeginMap;
+        out << YAML::Key << "layout" << YAML::Value << plan_.layout;
+        out << YAML::Key << "frames" << YAML::Value << delivered_;
+        out << YAML::Key << "frames_per_pass" << YAML::Value << plan_.frames.size();
+        out << YAML::Key << "passes_completed" << YAML::Value << pass_;
+        out << YAML::Key << "frames_dropped_at_end" << YAML::Value << plan_.droppedAtEnd;
+        out << YAML::EndMap;
+        return out.c_str();
+    }
+
+private:
+    // rate_hz > 0: frames are due one period apart; a late consumer gets the next frame
+    // at once but no burst of frames to catch up.
+    void waitUntilDue(int32_t timeout_ms) {
+        if (settings_.rateHz <= 0) return;
+        using namespace std::chrono;
+        const auto now = steady_clock::now();
+        if (due_ > now) {
+            if (timeout_ms >= 0 && due_ - now > milliseconds(timeout_ms)) {
+                std::this_thread::sleep_for(milliseconds(timeout_ms));
+                throw Error(BINOCLE_ERR_TIMEOUT, "replay: next frame due after the timeout of " +
+                                                     std::to_string(timeout_ms) + " ms (rate_hz " +
+                                                     std::to_string(settings_.rateHz) + ")");
+            }
+            std::this_thread::sleep_until(due_);
+        }
+        due_ = std::max(due_, steady_clock::now() - nanoseconds(periodNs_)) + nanoseconds(periodNs_);
+    }
+
+    // Decodes the pair and its ground truth; false when the frame was the cut-short end
+    // of a recording and has been dropped.
+    bool decode(const FrameFiles &files, Pixels &px) {
+        // Pixels as stored: the calibration speaks of the sensor's rows, whatever EXIF says.
+        const int flags = (settings_.gray ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR) | cv::IMREAD_IGNORE_ORIENTATION;
+        px.left = cv::imread(files.left.string(), flags);
+        px.right = cv::imread(files.right.string(), flags);
+        for (const bool isLeft : {true, false}) {
+            const cv::Mat &mat = isLeft ? px.left : px.right;
+            const fs::path &path = isLeft ? files.left : files.right;
+            const char *side = isLeft ? "left" : "right";
+            if (!mat.empty()) continue;
+            if (plan_.lenientLastFrame && next_ + 1 == plan_.frames.size()) {
+                host_.warning("replay: cannot decode the last recorded " + std::string(side) + " image " + inQuotes(path) +
+                              ": a recording cut short; the frame is ignored");
+                plan_.frames.pop_back();
+                plan_.lenientLastFrame = false;
+                ++plan_.droppedAtEnd;
+                return false;
+            }
+            throw Error(fs::exists(path) ? BINOCLE_ERR_IO : BINOCLE_ERR_NOT_FOUND,
+                        "replay: cannot read " + std::string(side) + " image " + inQuotes(path) +
+                            (fs::exists(path) ? ": expected an image file OpenCV can decode" : ": no such file"));
+        }
+        if (px.left.size() != px.right.size())
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: left image " + inQuotes(files.left) + " is " +
+                                                          sizeText(px.left) + " but right image " + inQuotes(files.right) +
+                                                          " is " + sizeText(px.right) + "; a pair must have one size");
+        if (!files.groundTruth.empty()) {
+            GroundTruth gt = readGroundTruth(files.groundTruth, settings_.groundTruthScale);
+            if (gt.disparity.size() != px.left.size())
+                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + inQuotes(files.groundTruth) + " is " +
+                                                              sizeText(gt.disparity) + " but left image " +
+                                                              inQuotes(files.left) + " is " + sizeText(px.left));
+            px.gtDisparity = gt.disparity;
+            px.gtValid = gt.valid;
+        }
+        return true;
+    }
+
+    std::unique_ptr<sdk::Frame> makeFrame(const FrameFiles &files, std::shared_ptr<Pixels> px) {
+        auto frame = std::make_unique<sdk::Frame>();
+        frame->sequence = sequence_;
+        if (files.hasTimestamps) {
+            frame->timestamp_left_ns = files.timestampLeftNs + pass_ * passNs_;
+            frame->timestamp_right_ns = files.timestampRightNs + pass_ * passNs_;
+        } else {
+            frame->timestamp_left_ns = frame->timestamp_right_ns = static_cast<int64_t>(sequence_) * periodNs_;
+        }
+        const int32_t format = settings_.gray ? BINOCLE_PIXEL_GRAY8 : BINOCLE_PIXEL_BGR8;
+        frame->left = lend(px->left, format);
+        frame->right = lend(px->right, format);
+        if (!px->gtDisparity.empty()) {
+            frame->extras.emplace_back("gt_disparity", lend(px->gtDisparity, BINOCLE_PIXEL_FLOAT32));
+            frame->extras.emplace_back("gt_valid", lend(px->gtValid, BINOCLE_PIXEL_GRAY8));
+        }
+        frame->metadata = metadata(files);
+        frame->owner = std::move(px);
+        ++sequence_;
+        ++delivered_;
+        ++next_;
+        return frame;
+    }
+
+    std::string metadata(const FrameFiles &files) const {
+        YAML::Emitter out;
+        out << YAML::BeginMap;
+        out << YAML::Key << "frame_index" << YAML::Value << next_ + static_cast<size_t>(settings_.firstFrame);
+        out << YAML::Key << "left_file" << YAML::Value << files.left.string();
+        out << YAML::Key << "right_file" << YAML::Value << files.right.string();
+        if (!files.groundTruth.empty())
+            out << YAML::Key << "ground_truth_file" << YAML::Value << files.groundTruth.string();
+        for (const auto &[key, value] : files.facts) out << YAML::Key << key << YAML::Value << value;
+        out << YAML::EndMap;
+        return out.c_str();
+    }
+
+    sdk::Host host_;
+    Settings settings_;
+    Plan plan_;
+    int64_t periodNs_ = 0;
+    int64_t passNs_ = 0;
+    bool started_ = false;
+    std::chrono::steady_clock::time_point due_{};
+    size_t next_ = 0;        // index in plan_.frames of the next frame
+    uint64_t sequence_ = 0;  // of the next frame delivered
+    uint64_t delivered_ = 0;
+    int64_t pass_ = 0;       // completed passes (loop)
+};
+
+} // namespace
+} // namespace binocle::replay
+
+BINOCLE_EXPORT_SOURCE(binocle::replay::ReplaySource, "replay", "1.0.0",
+                      "Plays stereo pairs back from files: glob patterns, Middlebury, KITTI or a binocle recording")

@@ -1,0 +1,238 @@
+// SPDX-License-Identifier: MIT
+// File helpers of the replay source: glob patterns, natural order, PFM, disparity ground truth.
+#include "replay_files.hpp"
+
+#include <binocle/plugin.hpp>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace binocle::replay {
+
+using sdk::Error;
+
+bool hasWildcard(const std::string &text) { return text.find_first_of("*?[") != std::string::npos; }
+
+namespace {
+
+// Matches the bracket expression starting at p[i] == '['; on success sets `next` to the
+// index after ']'. A '[' without its ']' is an ordinary character (returns false, next = 0).
+bool matchBracket(const std::string &p, size_t i, char c, size_t &next) {
+    size_t j = i + 1;
+    bool negate = j < p.size() && (p[j] == '!' || p[j] == '^');
+    if (negate) ++j;
+    bool matched = false;
+    bool first = true;
+    for (; j < p.size() && (first || p[j] != ']'); ++j, first = false) {
+        if (j + 2 < p.size() && p[j + 1] == '-' && p[j + 2] != ']') {
+            if (p[j] <= c && c <= p[j + 2]) matched = true;
+            j += 2;
+        } else if (p[j] == c) {
+            matched = true;
+        }
+    }
+    if (j >= p.size()) {
+        next = 0;
+        return false;
+    }
+    next = j + 1;
+    return matched != negate;
+}
+
+bool matchFrom(const std::string &p, size_t pi, const std::string &s, size_t si) {
+    while (pi < p.size()) {
+        if (p[pi] == '*') {
+            while (pi < p.size() && p[pi] == '*') ++pi;
+            if (pi == p.size()) return true;
+            for (size_t k = si; k <= s.size(); ++k)
+                if (matchFrom(p, pi, s, k)) return true;
+            return false;
+        }
+        if (si == s.size()) return false;
+        if (p[pi] == '?') {
+            ++pi;
+            ++si;
+            continue;
+        }
+        if (p[pi] == '[') {
+            size_t next = 0;
+            bool ok = matchBracket(p, pi, s[si], next);
+            if (next != 0) {
+                if (!ok) return false;
+                pi = next;
+                ++si;
+                continue;
+            }
+        }
+        if (p[pi] != s[si]) return false;
+        ++pi;
+        ++si;
+    }
+    return si == s.size();
+}
+
+bool isDigit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+void sortNaturally(std::vector<fs::path> &paths) {
+    std::sort(paths.begin(), paths.end(),
+              [](const fs::path &a, const fs::path &b) { return naturalLess(a.string(), b.string()); });
+}
+
+} // namespace
+
+bool wildcardMatch(const std::string &pattern, const std::string &name) {
+    if (!name.empty() && name[0] == '.' && (pattern.empty() || pattern[0] != '.')) return false;
+    return matchFrom(pattern, 0, name, 0);
+}
+
+bool naturalLess(const std::string &a, const std::string &b) {
+    size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+        if (isDigit(a[i]) && isDigit(b[j])) {
+            size_t ie = i, je = j;
+            while (ie < a.size() && isDigit(a[ie])) ++ie;
+            while (je < b.size() && isDigit(b[je])) ++je;
+            size_t ia = i, jb = j; // skip leading zeros, keeping one digit
+            while (ia + 1 < ie && a[ia] == '0') ++ia;
+            while (jb + 1 < je && b[jb] == '0') ++jb;
+            if (ie - ia != je - jb) return ie - ia < je - jb;
+            int c = a.compare(ia, ie - ia, b, jb, je - jb);
+            if (c != 0) return c < 0;
+            i = ie;
+            j = je;
+        } else {
+            if (a[i] != b[j]) return static_cast<unsigned char>(a[i]) < static_cast<unsigned char>(b[j]);
+            ++i;
+            ++j;
+        }
+    }
+    if (a.size() - i != b.size() - j) return a.size() - i < b.size() - j;
+    return a < b; // equal by value ("7" and "007"): any fixed order will do
+}
+
+std::vector<fs::path> globPaths(const std::string &pattern) {
+    fs::path whole(pattern);
+    std::vector<fs::path> current{whole.has_root_path() ? whole.root_path() : fs::path(".")};
+    std::error_code ec;
+    for (const fs::path &part : whole.relative_path()) {
+        const std::string text = part.string();
+        if (text.empty()) continue;
+        std::vector<fs::path> next;
+        for (const fs::path &base : current) {
+            if (!hasWildcard(text)) {
+                fs::path candidate = base / part;
+                if (fs::exists(candidate, ec)) next.push_back(candidate);
+                continue;
+            }
+            if (!fs::is_directory(base, ec)) continue;
+            std::vector<fs::path> matches;
+            for (fs::directory_iterator it(base, ec), end; !ec && it != end; it.increment(ec))
+                if (wildcardMatch(text, it->path().filename().string())) matches.push_back(it->path());
+            sortNaturally(matches);
+            next.insert(next.end(), matches.begin(), matches.end());
+        }
+        current.swap(next);
+    }
+    if (!whole.has_root_path())
+        for (fs::path &p : current) p = p.lexically_relative(".");
+    sortNaturally(current);
+    return current;
+}
+
+std::vector<fs::path> listFolder(const fs::path &folder, bool folders) {
+    std::vector<fs::path> out;
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        if (it->path().filename().string().rfind('.', 0) == 0) continue; // hidden
+        if (folders ? it->is_directory(ec) : it->is_regular_file(ec)) out.push_back(it->path());
+    }
+    sortNaturally(out);
+    return out;
+}
+
+cv::Mat readPfm(const fs::path &path) {
+    const std::string name = "'" + path.string() + "'";
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot open PFM file " + name);
+    std::string magic;
+    int width = 0, height = 0;
+    double scale = 0;
+    in >> magic >> width >> height >> scale;
+    if (!in || (magic != "Pf" && magic != "PF") || width <= 0 || height <= 0 || scale == 0 ||
+        width > 1 << 16 || height > 1 << 16)
+        throw Error(BINOCLE_ERR_IO, "replay: " + name +
+                                        " is not a PFM file (expected a header 'Pf' or 'PF', width, height and a non-zero scale)");
+    in.get(); // the single whitespace character that ends the header
+    const int channels = magic == "PF" ? 3 : 1;
+    const size_t rowFloats = static_cast<size_t>(width) * channels;
+    std::vector<float> data(rowFloats * height);
+    const auto bytes = static_cast<std::streamsize>(data.size() * sizeof(float));
+    in.read(reinterpret_cast<char *>(data.data()), bytes);
+    if (in.gcount() != bytes)
+        throw Error(BINOCLE_ERR_IO, "replay: PFM file " + name + " is truncated: " + std::to_string(width) + "x" +
+                                        std::to_string(height) + "x" + std::to_string(channels) + " floats need " +
+                                        std::to_string(bytes) + " bytes, found " + std::to_string(in.gcount()));
+    const uint16_t probe = 1;
+    const bool hostLittle = *reinterpret_cast<const uint8_t *>(&probe) == 1;
+    const bool fileLittle = scale < 0;
+    if (hostLittle != fileLittle) {
+        for (float &v : data) {
+            uint8_t b[4];
+            std::memcpy(b, &v, 4);
+            std::swap(b[0], b[3]);
+            std::swap(b[1], b[2]);
+            std::memcpy(&v, b, 4);
+        }
+    }
+    cv::Mat out(height, width, CV_32FC(channels));
+    for (int r = 0; r < height; ++r) // the file's first row is the image's bottom row
+        std::memcpy(out.ptr<float>(height - 1 - r), data.data() + rowFloats * r, rowFloats * sizeof(float));
+    return out;
+}
+
+GroundTruth readGroundTruth(const fs::path &path, double scale) {
+    const std::string name = "'" + path.string() + "'";
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    cv::Mat raw = ext == ".pfm" ? readPfm(path) : cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    if (raw.empty())
+        throw Error(fs::exists(path) ? BINOCLE_ERR_IO : BINOCLE_ERR_NOT_FOUND,
+                    "replay: cannot read ground truth " + name + " (expected a 16-bit PNG (d*256), 8-bit PNG or PFM)");
+    if (raw.channels() != 1)
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + name + " has " + std::to_string(raw.channels()) +
+                                                      " channels; expected a one-channel disparity image");
+    GroundTruth gt;
+    switch (raw.depth()) {
+    case CV_16U:
+        raw.convertTo(gt.disparity, CV_32F, scale / 256.0);
+        cv::compare(raw, 0, gt.valid, cv::CMP_GT);
+        break;
+    case CV_8U:
+        raw.convertTo(gt.disparity, CV_32F, scale);
+        cv::compare(raw, 0, gt.valid, cv::CMP_GT);
+        break;
+    case CV_32F: {
+        cv::Mat positive, finite;
+        cv::compare(raw, 0.0, positive, cv::CMP_GT); // NaN compares false
+        cv::compare(raw, std::numeric_limits<double>::max(), finite, cv::CMP_LT);
+        gt.valid = positive & finite;
+        raw.convertTo(gt.disparity, CV_32F, scale);
+        break;
+    }
+    default:
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                    "replay: ground truth " + name + " has an unsupported pixel depth; expected 8-bit, 16-bit or float");
+    }
+    gt.disparity.setTo(-1.0f, ~gt.valid);
+    return gt;
+}
+
+} // namespace binocle::replay

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// File helpers of the replay source: glob patterns, natural order, PFM, disparity ground truth.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace binocle::replay {
+
+// True when the text holds a glob wildcard: *, ? or [.
+bool hasWildcard(const std::string &text);
+
+// Shell-style match of one path component: * (any run), ? (one character), [abc],
+// [a-z], [!a] or [^a]. A leading '.' in `name` must be matched literally.
+bool wildcardMatch(const std::string &pattern, const std::string &name);
+
+// "left_2" < "left_10": runs of digits compare by value, the rest byte by byte.
+bool naturalLess(const std::string &a, const std::string &b);
+
+// Every existing path (file or folder) that the pattern names, in natural order.
+// Wildcards may stand in any component ("/data/*/im0.png"). A pattern without
+// wildcards yields itself when it exists.
+std::vector<std::filesystem::path> globPaths(const std::string &pattern);
+
+// The entries of a folder, in natural order; regular files or folders only.
+std::vector<std::filesystem::path> listFolder(const std::filesystem::path &folder, bool folders);
+
+// Portable Float Map: "Pf" (1 channel) or "PF" (3 channels), negative scale =
+// little-endian, rows stored bottom to top. Returns CV_32FC1 or CV_32FC3, top row first,
+// values as stored (inf stays inf). Throws sdk::Error naming the file.
+cv::Mat readPfm(const std::filesystem::path &path);
+
+// A disparity ground truth, decoded by format:
+//   16-bit PNG  value / 256 (KITTI), 0 = unknown
+//   8-bit image value, 0 = unknown
+//   PFM / float value, inf, NaN and <= 0 = unknown
+// then multiplied by `scale`. disparity: CV_32F, -1 where unknown; valid: CV_8U 0/255.
+struct GroundTruth {
+    cv::Mat disparity;
+    cv::Mat valid;
+};
+GroundTruth readGroundTruth(const std::filesystem::path &path, double scale);
+
+} // namespace binocle::replay
