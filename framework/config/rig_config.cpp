@@ -43,13 +43,18 @@ std::string nearest(const std::string &word, const std::vector<std::string> &can
         }
         return prev[b.size()];
     };
+    auto commonPrefix = [](const std::string &a, const std::string &b) {
+        size_t n = 0;
+        while (n < a.size() && n < b.size() && a[n] == b[n]) ++n;
+        return n;
+    };
     std::string best;
-    size_t bestD = std::max<size_t>(2, word.size() / 3) + 1;
+    size_t bestD = std::max<size_t>(2, word.size() / 3) + 1, bestPrefix = 0;
     for (const auto &c : candidates) {
-        size_t d = distance(word, c);
-        // A prefix relation ("num_disparity" / "num_disparities") counts as close.
-        if (c.rfind(word, 0) == 0 || word.rfind(c, 0) == 0) d = std::min<size_t>(d, 1);
-        if (d < bestD) bestD = d, best = c;
+        const size_t d = distance(word, c), prefix = commonPrefix(word, c);
+        // Ties go to the longer common prefix: "num_disparity" -> "num_disparities",
+        // not "min_disparity".
+        if (d < bestD || (d == bestD && !best.empty() && prefix > bestPrefix)) bestD = d, best = c, bestPrefix = prefix;
     }
     return best;
 }

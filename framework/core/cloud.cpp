@@ -39,13 +39,14 @@ Cloud cloudFromDisparity(const cv::Mat &disparity, const StereoCalibration &cal,
     cloud.image_width = disparity.cols;
     cloud.image_height = disparity.rows;
     const bool color = !left.empty() && left.size() == disparity.size();
-    cv::Matx44d Q;
-    cal.Q.convertTo(cv::Mat(Q), CV_64F);
+    if (cal.Q.empty()) throw Error("cloud: the calibration has no Q matrix (rectification not computed)");
+    cv::Mat q64, r64;
+    cal.Q.convertTo(q64, CV_64F);
+    const cv::Matx44d Q(q64.reshape(1, 1).ptr<double>());
     cv::Matx33d R1t = cv::Matx33d::eye();
     if (!cal.R1.empty()) {
-        cv::Matx33d R1;
-        cal.R1.convertTo(cv::Mat(R1), CV_64F);
-        R1t = R1.t();
+        cal.R1.convertTo(r64, CV_64F);
+        R1t = cv::Matx33d(r64.reshape(1, 1).ptr<double>()).t();
     }
     const size_t reserve = static_cast<size_t>(cv::countNonZero(disparity > 0));
     cloud.xyz.reserve(3 * reserve);

@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// The `binocle` command end to end: help, plugins, and a run on the real opencv-doc
+// pair checked against its ground-truth disparity.
+#include "common/test_util.hpp"
+#include "core/cloud.hpp"
+#include "core/image_io.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+using binocle::test::runCli;
+using binocle::test::TempDir;
+
+namespace {
+
+TEST(Cli, EveryCommandHasHelp) {
+    auto top = runCli("--help");
+    ASSERT_EQ(top.exit_code, 0) << top.output;
+    for (const char *cmd : {"plugins", "run"}) {
+        EXPECT_NE(top.output.find(cmd), std::string::npos) << cmd;
+        auto r = runCli(std::string(cmd) + " --help");
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        EXPECT_NE(r.output.find("usage: binocle " + std::string(cmd)), std::string::npos) << r.output;
+    }
+    EXPECT_EQ(runCli("frobnicate").exit_code, 2);
+}
+
+TEST(Cli, PluginsListsTheBuiltInOnesWithVersions) {
+    auto r = runCli("plugins");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char *name : {"replay", "bm", "sgbm", "ground"}) {
+        EXPECT_NE(r.output.find(std::string("  ") + name + " "), std::string::npos) << name << "\n" << r.output;
+    }
+    EXPECT_NE(r.output.find("ABI 1 API 1"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RunOnTheOpenCvPairMatchesGroundTruth) {
+    TempDir out;
+    auto r = runCli("run " BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml --quiet --out " + out.str());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char *f : {"disparity_000000.png", "disparity_color_000000.png", "cloud_000000.ply", "summary.json"})
+        EXPECT_TRUE(std::filesystem::exists(out.path() / f)) << f;
+
+    // 16-bit KITTI PNG against the 8-bit ground truth (disparity in px, 0 = unknown).
+    cv::Mat d = binocle::readDisparityPng16(out.str("disparity_000000.png"));
+    cv::Mat gt = cv::imread(BINOCLE_OPENCV_DATA_DIR "/aloeGT.png", cv::IMREAD_GRAYSCALE);
+    ASSERT_EQ(d.size(), gt.size());
+    int64_t known = 0, compared = 0, bad = 0;
+    for (int v = 0; v < d.rows; ++v)
+        for (int u = 0; u < d.cols; ++u) {
+            if (gt.at<uint8_t>(v, u) == 0) continue;
+            ++known;
+            const float x = d.at<float>(v, u);
+            if (!(x > 0)) continue;
+            ++compared;
+            if (std::abs(x - gt.at<uint8_t>(v, u)) > 3.0f) ++bad;
+        }
+    const double density = double(compared) / known, badRate = double(bad) / compared;
+    std::cout << "aloe sgbm: density " << density << ", bad (>3 px) " << badRate << "\n";
+    // Measured: density 0.72, bad-3px 0.05 (sgbm, 256 disparities, block 5).
+    EXPECT_GT(density, 0.65);
+    EXPECT_LT(badRate, 0.10);
+
+    binocle::Cloud cloud = binocle::readPly(out.str("cloud_000000.ply"));
+    EXPECT_EQ(cloud.frame, BINOCLE_FRAME_GROUND);
+    EXPECT_GT(cloud.size(), 500000u);
+    const std::string summary = binocle::test::runCommand("cat " + out.str("summary.json")).output;
+    EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
+}
+
+TEST(Cli, RunOnAMissingRigFailsWithTheFileName) {
+    auto r = runCli("run /nonexistent/rig.yaml");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("/nonexistent/rig.yaml does not exist"), std::string::npos) << r.output;
+}
+
+TEST(Cli, MisspeltKeyOnTheCommandLineIsReported) {
+    auto r = runCli("run " BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml --set matcher.num_disparity=64");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("did you mean 'num_disparities'"), std::string::npos) << r.output;
+}
+
+} // namespace

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: MIT
+// Rig YAML: validation against plugin tables, errors with file:line:col, --set overrides.
+#include "common/test_util.hpp"
+#include "config/rig_config.hpp"
+#include "core/calibration.hpp"
+#include "core/error.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace binocle;
+using binocle::test::TempDir;
+using binocle::test::writeText;
+
+namespace {
+
+class RigConfigTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        host_ = new PluginHost({BINOCLE_BUILD_PLUGIN_DIR});
+        host_->scan();
+    }
+    static void TearDownTestSuite() { delete host_; }
+
+    // A valid rig; `matcher` replaces the matcher block's lines.
+    std::string rig(const std::string &matcher = "  plugin: sgbm\n  num_disparities: 64\n  block_size: 5\n") {
+        return "name: test\n"
+               "source:\n"
+               "  plugin: replay\n"
+               "  layout: glob\n"
+               "  left: " BINOCLE_OPENCV_DATA_DIR "/aloeL.jpg\n"
+               "  right: " BINOCLE_OPENCV_DATA_DIR "/aloeR.jpg\n"
+               "matcher:\n" +
+               matcher +
+               "transforms:\n"
+               "  - plugin: ground\n"
+               "    camera_height_mm: 1200\n"
+               "    inclination_deg: 5\n";
+    }
+    std::string write(const std::string &text) {
+        const std::string path = dir_.str("rig.yaml");
+        writeText(path, text);
+        return path;
+    }
+    std::string errorOf(const std::string &text, const std::vector<Override> &overrides = {}) {
+        const std::string path = write(text);
+        try {
+            loadRig(path, overrides, *host_);
+        } catch (const Error &e) {
+            return e.what();
+        }
+        return "";
+    }
+
+    static PluginHost *host_;
+    TempDir dir_;
+};
+
+PluginHost *RigConfigTest::host_ = nullptr;
+
+TEST_F(RigConfigTest, ValidRigResolvesPluginsAndDefaults) {
+    RigConfig r = loadRig(write(rig()), {}, *host_);
+    EXPECT_EQ(r.name, "test");
+    EXPECT_EQ(r.source.plugin, "replay");
+    EXPECT_EQ(r.matcher.plugin, "sgbm");
+    ASSERT_NE(r.matcher.params.find("num_disparities"), nullptr);
+    EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 64);
+    EXPECT_EQ(r.matcher.params.find("num_disparities")->explicit_, 1);
+    // Every declared setting reaches the plugin, defaults marked as such.
+    EXPECT_EQ(r.matcher.params.size(), static_cast<int32_t>(r.matcher.record->params().size()));
+    ASSERT_EQ(r.transforms.size(), 1u);
+    EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 5.0);
+}
+
+TEST_F(RigConfigTest, MisspeltKeyNamesLineColumnAndValidKey) {
+    const std::string err = errorOf(rig("  plugin: sgbm\n  num_disparity: 64\n"));
+    // matcher block starts on line 7; the misspelt key is on line 9, column 3.
+    EXPECT_NE(err.find("rig.yaml:9:3"), std::string::npos) << err;
+    EXPECT_NE(err.find("unknown key 'num_disparity'"), std::string::npos) << err;
+    EXPECT_NE(err.find("did you mean 'num_disparities'"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, WrongTypeIsAnErrorWithValueAndExpectation) {
+    const std::string err = errorOf(rig("  plugin: sgbm\n  num_disparities: lots\n"));
+    EXPECT_NE(err.find("rig.yaml:9:20"), std::string::npos) << err;
+    EXPECT_NE(err.find("matcher.num_disparities"), std::string::npos) << err;
+    EXPECT_NE(err.find("'lots'"), std::string::npos) << err;
+    EXPECT_NE(err.find("multiple of 16"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, OutOfRangeValuesAreRefused) {
+    std::string err = errorOf(rig("  plugin: sgbm\n  num_disparities: 100\n"));
+    EXPECT_NE(err.find("'100'"), std::string::npos) << err;
+    EXPECT_NE(err.find("multiple of 16"), std::string::npos) << err;
+    err = errorOf(rig("  plugin: bm\n  block_size: 8\n"));
+    EXPECT_NE(err.find("matcher.block_size"), std::string::npos) << err;
+    EXPECT_NE(err.find("odd"), std::string::npos) << err;
+    err = errorOf(rig() + "    extra: 1\n");
+    EXPECT_NE(err.find("unknown key 'extra'"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, MissingPluginSuggestsTheNearestOne) {
+    const std::string err = errorOf(rig("  plugin: sgbn\n"));
+    EXPECT_NE(err.find("rig.yaml:8:11"), std::string::npos) << err;
+    EXPECT_NE(err.find("no matcher plugin named 'sgbn'"), std::string::npos) << err;
+    EXPECT_NE(err.find("did you mean 'sgbm'"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, UnknownTopLevelKeyAndMissingBlock) {
+    std::string err = errorOf(rig() + "matchr: {}\n");
+    EXPECT_NE(err.find("unknown key 'matchr'"), std::string::npos) << err;
+    err = errorOf("source: {plugin: replay}\n");
+    EXPECT_NE(err.find("missing block 'matcher'"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, SetOverridesAnyValueAndIsNamedInErrors) {
+    RigConfig r = loadRig(write(rig()), {Override::parse("matcher.num_disparities=128"),
+                                         Override::parse("transforms.0.inclination_deg=10"),
+                                         Override::parse("matcher.plugin=bm")},
+                          *host_);
+    EXPECT_EQ(r.matcher.plugin, "bm");
+    EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 128);
+    EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 10.0);
+    const std::string err = errorOf(rig(), {Override::parse("matcher.num_disparities=100")});
+    EXPECT_NE(err.find("command line --set matcher.num_disparities=100"), std::string::npos) << err;
+    EXPECT_THROW(Override::parse("novalue"), Error);
+    EXPECT_THROW(loadRig(write(rig()), {Override::parse("transforms.7.x=1")}, *host_), Error);
+}
+
+TEST_F(RigConfigTest, SwappingBmForSgbmIsOneLine) {
+    const std::string sgbm = rig("  plugin: sgbm\n  num_disparities: 64\n  block_size: 5\n");
+    std::string bm = sgbm;
+    bm.replace(bm.find("plugin: sgbm"), 12, "plugin: bm  ");
+    EXPECT_EQ(loadRig(write(sgbm), {}, *host_).matcher.plugin, "sgbm");
+    EXPECT_EQ(loadRig(write(bm), {}, *host_).matcher.plugin, "bm");
+}
+
+TEST_F(RigConfigTest, RelativePathsResolveAgainstTheRigFolder) {
+    StereoCalibration::ideal({1282, 1110}, 3740, 160).save(dir_.str("cal.yml"));
+    RigConfig r = loadRig(write(rig() + "calibration: cal.yml\n"), {}, *host_);
+    ASSERT_TRUE(r.calibration_file.has_value());
+    EXPECT_EQ(*r.calibration_file, dir_.str("cal.yml"));
+    const std::string err = errorOf(rig() + "calibration: nowhere.yml\n");
+    EXPECT_NE(err.find("nowhere.yml' does not exist"), std::string::npos) << err;
+}
+
+TEST_F(RigConfigTest, YamlSyntaxErrorHasLineAndColumn) {
+    const std::string err = errorOf("source: [plugin: replay\nmatcher: x\n");
+    EXPECT_NE(err.find("rig.yaml:"), std::string::npos) << err;
+    EXPECT_NE(err.find("YAML syntax error"), std::string::npos) << err;
+}
+
+TEST(Nearest, FindsCloseNamesOnly) {
+    EXPECT_EQ(nearest("num_disparity", {"num_disparities", "block_size"}), "num_disparities");
+    EXPECT_EQ(nearest("blok_size", {"num_disparities", "block_size"}), "block_size");
+    EXPECT_EQ(nearest("zzz", {"num_disparities", "block_size"}), "");
+}
+
+} // namespace
