@@ -18,6 +18,15 @@ function(binocle_add_plugin name)
     CXX_VISIBILITY_PRESET hidden
     C_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON)
+  # Export the init symbol only: a version script also hides the weak template
+  # instantiations (std::string, ...) that visibility flags alone leave exported.
+  set(version_script "${CMAKE_BINARY_DIR}/binocle_plugin.map")
+  if(NOT EXISTS "${version_script}")
+    file(WRITE "${version_script}" "{ global: binocle_plugin_init; local: *; };\n")
+  endif()
+  if(NOT APPLE AND NOT WIN32)
+    target_link_options(${target} PRIVATE "LINKER:--version-script=${version_script}")
+  endif()
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${ARG_OUTPUT_DIRECTORY}")
   elseif(DEFINED BINOCLE_BUILD_PLUGIN_DIR)
