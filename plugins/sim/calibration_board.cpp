@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: MIT
+// Calibration mode of the `sim` source: a chessboard held in varied poses in front of
+// the rig, one pose per frame, for `binocle calibrate` and its tests.
+#include "calibration_board.hpp"
+
+#include "random.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace binocle::sim {
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+
+} // namespace
+
+BoardSettings BoardSettings::fromYaml(const std::string &text) {
+    BoardSettings b;
+    YAML::Node n;
+    try {
+        n = YAML::Load(text);
+    } catch (const YAML::Exception &e) {
+        throw SceneError("calibration_board: not valid YAML: " + e.msg);
+    }
+    if (!n.IsMap()) throw SceneError("calibration_board: expected a map {cols, rows, square_mm, poses}");
+    for (const auto &kv : n) {
+        const std::string key = kv.first.as<std::string>();
+        try {
+            if (key == "cols") b.cols = kv.second.as<int>();
+            else if (key == "rows") b.rows = kv.second.as<int>();
+            else if (key == "square_mm") b.square_mm = kv.second.as<double>();
+            else if (key == "poses") b.poses = kv.second.as<int>();
+            else if (key == "max_tilt_deg") b.max_tilt_deg = kv.second.as<double>();
+            else if (key == "seed") b.seed = kv.second.as<uint32_t>();
+            else
+                throw SceneError("calibration_board: unknown key '" + key +
+                                 "' (expected cols, rows, square_mm, poses, max_tilt_deg, seed)");
+        } catch (const YAML::Exception &) {
+            throw SceneError("calibration_board." + key + " = '" + kv.second.as<std::string>("?") + "': expected a number");
+        }
+    }
+    if (b.cols < 2 || b.rows < 2) throw SceneError("calibration_board: cols and rows must be >= 2 (inner corners)");
+    if (!(b.square_mm > 0)) throw SceneError("calibration_board.square_mm: expected a value > 0");
+    if (b.poses < 1) throw SceneError("calibration_board.poses: expected a value >= 1");
+    if (b.max_tilt_deg < 0 || b.max_tilt_deg > 60) throw SceneError("calibration_board.max_tilt_deg: expected 0..60");
+    return b;
+}
+
+Scene boardScene(const BoardSettings &b, const StereoRig &rig, int index) {
+    const RigSettings &s = rig.settings();
+    Scene scene;
+    scene.name = "calibration_board";
+    scene.groundTexture = -1;
+    scene.sky.zenith = scene.sky.horizon = Rgb::Constant(0.5f);
+    scene.light.direction = Vec3(0, -1, 0.3).normalized();
+    scene.light.ambient = 0.7;
+
+    Texture t;
+    t.kind = TextureKind::Chessboard;
+    t.color0 = Rgb::Constant(0.08f);
+    t.color1 = Rgb::Constant(0.92f);
+    t.square_mm = b.square_mm;
+    t.board_squares[0] = b.cols + 1;
+    t.board_squares[1] = b.rows + 1;
+    t.margin_mm = b.square_mm;
+    const int board = scene.addTexture(t);
+    const int plain = scene.addTexture(Texture{}); // edges and back: grey
+    const double width = (b.cols + 3) * b.square_mm, height = (b.rows + 3) * b.square_mm;
+
+    // Distance and offsets such that the whole board (tilted, margin included) stays
+    // inside both images.
+    Random rng({b.seed, static_cast<uint32_t>(index), 0x0b0a4du});
+    const double f = s.focalLengthPx();
+    const double fraction = rng.uniform(0.35, 0.6);
+    double distance = f * width / (fraction * s.image_width);
+    const double slack = 1.25; // perspective of a tilted board
+    distance = std::max(distance, f * (width * slack + s.baseline_mm) / (s.image_width - 16.0));
+    distance = std::max(distance, f * height * slack / (s.image_height - 16.0));
+    const double freeU = std::max(0.0, (s.image_width - f * (width * slack + s.baseline_mm) / distance) / 2 - 8);
+    const double freeV = std::max(0.0, (s.image_height - f * height * slack / distance) / 2 - 8);
+    const Vec3 centreInCamera(s.baseline_mm / 2 + rng.uniform(-1, 1) * freeU * distance / f,
+                              rng.uniform(-1, 1) * freeV * distance / f, distance);
+    const double tiltX = rng.uniform(-1, 1) * b.max_tilt_deg * kDegToRad;
+    const double tiltY = rng.uniform(-1, 1) * b.max_tilt_deg * kDegToRad;
+    const double roll = rng.uniform(-1, 1) * 15 * kDegToRad;
+    // Board axes in the camera frame: X right, Y away from the rig (its normal), Z up.
+    Mat3 facing;
+    facing << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+    const Mat3 tilt = (Eigen::AngleAxisd(roll, Vec3::UnitZ()) * Eigen::AngleAxisd(tiltY, Vec3::UnitY()) *
+                       Eigen::AngleAxisd(tiltX, Vec3::UnitX()))
+                          .toRotationMatrix();
+    const Camera left = rig.left(RigPose{});
+    Primitive p;
+    p.shape = Shape::Box;
+    p.half = Vec3(width / 2, 2.0, height / 2);
+    p.rotation = left.rotation * tilt * facing;
+    p.axisAligned = false;
+    p.center = left.center + left.rotation * centreInCamera;
+    p.texture.fill(plain);
+    p.texture[3] = board; // -Y: the face towards the rig
+    scene.addObject("board", "calibration_board", {p});
+    scene.mainObject = -1;
+    return scene;
+}
+
+} // namespace binocle::sim

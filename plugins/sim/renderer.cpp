@@ -1,0 +1,394 @@
+// SPDX-License-Identifier: MIT
+// Ray caster of the `sim` source: renders a scene as the two imagers of a StereoRig see
+// it (supersampled, Lambert-shaded, with sensor noise) and the exact ground truth.
+#include "renderer.hpp"
+
+#include "random.hpp"
+
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace binocle::sim {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kEpsilon = 1e-6; // mm: hits closer than this to the origin are ignored
+
+// Slab test against axis-aligned bounds; true when the ray enters them before tMax.
+inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3 &hi, double tMax) {
+    double tn = 0, tf = tMax;
+    for (int a = 0; a < 3; ++a) {
+        double t1 = (lo[a] - o[a]) * inv[a], t2 = (hi[a] - o[a]) * inv[a];
+        if (t1 > t2) std::swap(t1, t2);
+        tn = std::max(tn, t1); // NaN (0 * inf) leaves tn / tf unchanged
+        tf = std::min(tf, t2);
+    }
+    return tn <= tf;
+}
+
+// Box in its own axes (centred at 0, half sizes h), inv = 1 / d per axis; seen from
+// outside only.
+inline bool hitBox(const Vec3 &o, const Vec3 &d, const Vec3 &inv, const Vec3 &h, double tMax, double &t, int &face) {
+    double tn = -kInf, tf = kInf;
+    int axis = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0) {
+            if (std::abs(o[a]) > h[a]) return false;
+            continue;
+        }
+        double t1 = (-h[a] - o[a]) * inv[a], t2 = (h[a] - o[a]) * inv[a];
+        if (t1 > t2) std::swap(t1, t2);
+        if (t1 > tn) {
+            tn = t1;
+            axis = a;
+        }
+        tf = std::min(tf, t2);
+        if (tn > tf) return false;
+    }
+    if (tn <= kEpsilon || tn >= tMax) return false;
+    t = tn;
+    face = 2 * axis + (d[axis] > 0 ? 1 : 0); // entering a +axis face when moving towards -axis
+    return true;
+}
+
+inline bool hitEllipsoid(const Primitive &p, const Vec3 &o, const Vec3 &d, double tMax, double &t) {
+    const Vec3 q = (o - p.center).cwiseQuotient(p.half), e = d.cwiseQuotient(p.half);
+    const double a = e.squaredNorm(), b = q.dot(e), c = q.squaredNorm() - 1.0;
+    const double disc = b * b - a * c;
+    if (disc < 0) return false;
+    const double tt = (-b - std::sqrt(disc)) / a;
+    if (tt <= kEpsilon || tt >= tMax) return false;
+    t = tt;
+    return true;
+}
+
+// Vertical cylinder, base disc centred at p.center, radius half.x, height half.z.
+inline bool hitCylinder(const Primitive &p, const Vec3 &o, const Vec3 &d, double tMax, double &t, int &face) {
+    const Vec3 q = o - p.center;
+    const double r = p.half.x(), h = p.half.z();
+    bool found = false;
+    const double a = d.x() * d.x() + d.y() * d.y();
+    if (a > 0) {
+        const double b = q.x() * d.x() + q.y() * d.y(), c = q.x() * q.x() + q.y() * q.y() - r * r;
+        const double disc = b * b - a * c;
+        if (disc >= 0) {
+            const double tt = (-b - std::sqrt(disc)) / a;
+            const double z = q.z() + tt * d.z();
+            if (tt > kEpsilon && tt < tMax && z >= 0 && z <= h) {
+                t = tMax = tt;
+                face = 0;
+                found = true;
+            }
+        }
+    }
+    if (d.z() != 0) {
+        const double capZ = d.z() < 0 ? h : 0.0;
+        const double tt = (capZ - q.z()) / d.z();
+        const double x = q.x() + tt * d.x(), y = q.y() + tt * d.y();
+        if (tt > kEpsilon && tt < tMax && x * x + y * y <= r * r) {
+            t = tt;
+            face = d.z() < 0 ? 4 : 5;
+            found = true;
+        }
+    }
+    return found;
+}
+
+inline Vec3 boxAxis(int face) {
+    Vec3 n = Vec3::Zero();
+    n[face / 2] = (face % 2 == 0) ? 1.0 : -1.0;
+    return n;
+}
+
+inline double clamp01(double v) { return v < 0 ? 0 : (v > 1 ? 1 : v); }
+
+// Surface coordinates (u, v) of point p on a face of a box: right and up as seen from
+// outside the face, origin at its corner.
+inline void boxFaceUv(const Primitive &prim, int face, const Vec3 &p, double &u, double &v) {
+    const Vec3 q = prim.axisAligned ? Vec3(p - prim.center) : Vec3(prim.rotation.transpose() * (p - prim.center));
+    const Vec3 &h = prim.half;
+    switch (face) {
+    case 0: u = q.y() + h.y(); v = q.z() + h.z(); break; // +X
+    case 1: u = h.y() - q.y(); v = q.z() + h.z(); break; // -X
+    case 2: u = h.x() - q.x(); v = q.z() + h.z(); break; // +Y
+    case 3: u = q.x() + h.x(); v = q.z() + h.z(); break; // -Y (faces the rig)
+    case 4: u = q.x() + h.x(); v = q.y() + h.y(); break; // +Z
+    default: u = q.x() + h.x(); v = h.y() - q.y(); break; // -Z
+    }
+}
+
+// Where the ray origin + s * dir meets the plane through p with normal n (tangent plane);
+// far away when it runs parallel to it or away from it.
+inline Vec3 onTangentPlane(const Vec3 &o, const Vec3 &dir, const Vec3 &p, const Vec3 &n) {
+    const double den = n.dot(dir), num = n.dot(p - o);
+    const double s = num / den;
+    if (!(s > 0) || !std::isfinite(s)) return p + 1e6 * dir.normalized();
+    return o + s * dir;
+}
+
+// One pixel's worth of ground truth from the ray through its centre.
+struct TruthRow {
+    float *disparity, *depth;
+    uint8_t *valid;
+    uint16_t *id;
+    void set(int u, const StereoRig &rig, const Tracer &tracer, bool hit, const Tracer::Hit &h, double cosAxis) {
+        const double z = hit ? h.t * cosAxis : 0.0;
+        if (z > 0 && std::isfinite(z)) {
+            depth[u] = static_cast<float>(z);
+            disparity[u] = static_cast<float>(rig.rectifiedDisparity(z));
+            valid[u] = 255;
+            id[u] = tracer.objectId(h);
+        } else {
+            depth[u] = 0;
+            disparity[u] = -1.0f;
+            valid[u] = 0;
+            id[u] = Scene::kSkyId;
+        }
+    }
+};
+
+void allocateTruth(RenderedFrame &out, int width, int height) {
+    out.gt_disparity.create(height, width, CV_32F);
+    out.gt_depth.create(height, width, CV_32F);
+    out.gt_valid.create(height, width, CV_8U);
+    out.gt_object_id.create(height, width, CV_16U);
+}
+
+TruthRow truthRow(RenderedFrame &out, int v) {
+    return {out.gt_disparity.ptr<float>(v), out.gt_depth.ptr<float>(v), out.gt_valid.ptr<uint8_t>(v),
+            out.gt_object_id.ptr<uint16_t>(v)};
+}
+
+} // namespace
+
+bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
+    double best = kInf;
+    bool found = false;
+    if (scene_.groundTexture >= 0 && d.z() < 0 && o.z() > 0) {
+        best = -o.z() / d.z();
+        hit.primitive = -1;
+        hit.face = 4;
+        found = true;
+    }
+    const Vec3 inv = d.cwiseInverse();
+    for (const SceneObject &obj : scene_.objects) {
+        if (!hitBounds(o, inv, obj.boundsMin, obj.boundsMax, best)) continue;
+        for (int i = obj.firstPrimitive; i < obj.firstPrimitive + obj.primitiveCount; ++i) {
+            const Primitive &p = scene_.primitives[static_cast<size_t>(i)];
+            double t = 0;
+            int face = 0;
+            bool h = false;
+            switch (p.shape) {
+            case Shape::Box:
+                if (p.axisAligned) {
+                    h = hitBox(o - p.center, d, inv, p.half, best, t, face);
+                } else {
+                    const Vec3 dl = p.rotation.transpose() * d;
+                    h = hitBox(p.rotation.transpose() * (o - p.center), dl, dl.cwiseInverse(), p.half, best, t, face);
+                }
+                break;
+            case Shape::Ellipsoid: h = hitEllipsoid(p, o, d, best, t); break;
+            case Shape::Cylinder: h = hitCylinder(p, o, d, best, t, face); break;
+            }
+            if (h) {
+                best = t;
+                hit.primitive = i;
+                hit.face = face;
+                found = true;
+            }
+        }
+    }
+    hit.t = best;
+    return found;
+}
+
+uint16_t Tracer::objectId(const Hit &hit) const {
+    if (hit.primitive < 0) return Scene::kGroundId;
+    return scene_.objects[static_cast<size_t>(scene_.primitives[static_cast<size_t>(hit.primitive)].object)].id;
+}
+
+Rgb Tracer::sky(const Vec3 &d) const {
+    const double k = clamp01(d.z() * 2.5);
+    return scene_.sky.horizon + (scene_.sky.zenith - scene_.sky.horizon) * static_cast<float>(k);
+}
+
+Rgb Tracer::shade(const Vec3 &o, const Vec3 &d, const Hit &hit, const Vec3 &dir, const Vec3 &dirDx,
+                  const Vec3 &dirDy) const {
+    const Vec3 p = o + hit.t * d;
+    SurfacePoint sp;
+    Vec3 n = Vec3::UnitZ();
+    int texture = scene_.groundTexture;
+    const Primitive *prim = hit.primitive >= 0 ? &scene_.primitives[static_cast<size_t>(hit.primitive)] : nullptr;
+    if (prim) {
+        texture = prim->texture[static_cast<size_t>(hit.face)];
+        switch (prim->shape) {
+        case Shape::Box: n = prim->axisAligned ? boxAxis(hit.face) : Vec3(prim->rotation * boxAxis(hit.face)); break;
+        case Shape::Ellipsoid:
+            n = (p - prim->center).cwiseQuotient(prim->half.cwiseProduct(prim->half)).normalized();
+            break;
+        case Shape::Cylinder:
+            if (hit.face == 0)
+                n = Vec3(p.x() - prim->center.x(), p.y() - prim->center.y(), 0).normalized();
+            else
+                n = hit.face == 4 ? Vec3::UnitZ() : Vec3(-Vec3::UnitZ());
+            break;
+        }
+    }
+    // Ray differentials: where the footprint's edges meet the tangent plane.
+    const Vec3 px = onTangentPlane(o, dir + dirDx, p, n), py = onTangentPlane(o, dir + dirDy, p, n);
+    if (!prim || prim->shape == Shape::Box) {
+        double u0, v0, ux, vx, uy, vy;
+        if (!prim) {
+            u0 = p.x(), v0 = p.y(), ux = px.x(), vx = px.y(), uy = py.x(), vy = py.y();
+        } else {
+            boxFaceUv(*prim, hit.face, p, u0, v0);
+            boxFaceUv(*prim, hit.face, px, ux, vx);
+            boxFaceUv(*prim, hit.face, py, uy, vy);
+        }
+        sp.u = u0;
+        sp.v = v0;
+        sp.dudx = ux - u0;
+        sp.dvdx = vx - v0;
+        sp.dudy = uy - u0;
+        sp.dvdy = vy - v0;
+    } else {
+        sp.planar = false;
+        sp.local = p - prim->textureOrigin;
+        sp.dldx = px - p;
+        sp.dldy = py - p;
+        sp.normal = n;
+    }
+    const Rgb albedo = evalTexture(scene_.textures[static_cast<size_t>(texture)], sp);
+    const double lambert = std::max(0.0, n.dot(scene_.light.direction));
+    const double light = scene_.light.ambient + (1.0 - scene_.light.ambient) * lambert;
+    return albedo * static_cast<float>(light);
+}
+
+cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, RenderedFrame *truth) const {
+    const Tracer tracer(scene);
+    const int n = std::max(1, settings_.antialias * settings_.binning); // samples per axis on edges
+    const Vec3 axis = cam.rotation.col(2);
+    // Change of the (unnormalised) ray direction from one pixel to the next.
+    const Vec3 stepX = cam.rotation.col(0) / cam.fx, stepY = cam.rotation.col(1) / cam.fy;
+    cv::Mat out(cam.height, cam.width, CV_32FC3);
+    cv::Mat surface(cam.height, cam.width, CV_32S); // what the centre ray hit: primitive and face
+    if (truth) allocateTruth(*truth, cam.width, cam.height);
+
+    // Pass 1: one ray through each pixel centre, texture filtered over the whole pixel.
+    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
+        for (int v = rows.start; v < rows.end; ++v) {
+            cv::Vec3f *row = out.ptr<cv::Vec3f>(v);
+            int32_t *ids = surface.ptr<int32_t>(v);
+            TruthRow gt{};
+            if (truth) gt = truthRow(*truth, v);
+            for (int u = 0; u < cam.width; ++u) {
+                const Vec3 dir = cam.direction(u, v), d = dir.normalized();
+                Tracer::Hit hit;
+                const bool found = tracer.trace(cam.center, d, hit);
+                const Rgb c = found ? tracer.shade(cam.center, d, hit, dir, stepX, stepY) : tracer.sky(d);
+                row[u] = cv::Vec3f(c.x(), c.y(), c.z());
+                ids[u] = found ? (hit.primitive + 2) * 8 + hit.face : 0;
+                if (truth) gt.set(u, rig_, tracer, found, hit, d.dot(axis));
+            }
+        }
+    });
+    if (n == 1) return out;
+
+    // Pass 2: pixels that straddle an edge (a neighbour's centre ray met another surface
+    // or face) are supersampled n x n.
+    const Vec3 subX = stepX / n, subY = stepY / n;
+    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
+        for (int v = rows.start; v < rows.end; ++v) {
+            cv::Vec3f *row = out.ptr<cv::Vec3f>(v);
+            const int32_t *ids = surface.ptr<int32_t>(v);
+            for (int u = 0; u < cam.width; ++u) {
+                bool edge = false;
+                for (int y = std::max(0, v - 1); y <= std::min(cam.height - 1, v + 1) && !edge; ++y) {
+                    const int32_t *r = surface.ptr<int32_t>(y);
+                    for (int x = std::max(0, u - 1); x <= std::min(cam.width - 1, u + 1); ++x)
+                        if (r[x] != ids[u]) {
+                            edge = true;
+                            break;
+                        }
+                }
+                if (!edge) continue;
+                Rgb sum = Rgb::Zero();
+                for (int j = 0; j < n; ++j) {
+                    for (int i = 0; i < n; ++i) {
+                        const Vec3 dir = cam.direction(u - 0.5 + (i + 0.5) / n, v - 0.5 + (j + 0.5) / n), d = dir.normalized();
+                        Tracer::Hit hit;
+                        sum += tracer.trace(cam.center, d, hit) ? tracer.shade(cam.center, d, hit, dir, subX, subY)
+                                                                 : tracer.sky(d);
+                    }
+                }
+                sum /= static_cast<float>(n * n);
+                row[u] = cv::Vec3f(sum.x(), sum.y(), sum.z());
+            }
+        }
+    });
+    return out;
+}
+
+cv::Mat Renderer::expose(const cv::Mat &radiance, int imager, uint64_t frame) const {
+    const bool right = imager == 1;
+    const double gain = 255.0 * (right ? settings_.gain_right : 1.0);
+    const double offset = right ? settings_.offset_right : 0.0;
+    const double sigma = settings_.noise_sigma / std::max(1, settings_.binning);
+    cv::Mat out(radiance.size(), settings_.color ? CV_8UC3 : CV_8UC1);
+    cv::parallel_for_(cv::Range(0, radiance.rows), [&](const cv::Range &rows) {
+        for (int v = rows.start; v < rows.end; ++v) {
+            // One generator per row: the same bytes whatever the number of threads.
+            Random rng({settings_.seed, static_cast<uint32_t>(frame), static_cast<uint32_t>(frame >> 32),
+                        static_cast<uint32_t>(imager), static_cast<uint32_t>(v)});
+            auto noise = [&] { return sigma > 0 ? sigma * rng.tableNormal() : 0.0; };
+            const cv::Vec3f *in = radiance.ptr<cv::Vec3f>(v);
+            uint8_t *dst = out.ptr<uint8_t>(v);
+            for (int u = 0; u < radiance.cols; ++u) {
+                const cv::Vec3f &c = in[u]; // R, G, B
+                if (!settings_.color) {
+                    const double grey = 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2];
+                    dst[u] = cv::saturate_cast<uint8_t>(grey * gain + offset + noise());
+                } else {
+                    for (int k = 0; k < 3; ++k) dst[3 * u + k] = cv::saturate_cast<uint8_t>(c[2 - k] * gain + offset + noise());
+                }
+            }
+        }
+    });
+    return out;
+}
+
+void Renderer::renderGroundTruth(const Scene &scene, const Camera &cam, RenderedFrame &out) const {
+    const Tracer tracer(scene);
+    allocateTruth(out, cam.width, cam.height);
+    const Vec3 axis = cam.rotation.col(2);
+    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
+        for (int v = rows.start; v < rows.end; ++v) {
+            TruthRow gt = truthRow(out, v);
+            for (int u = 0; u < cam.width; ++u) {
+                const Vec3 d = cam.ray(u, v);
+                Tracer::Hit hit;
+                const bool found = tracer.trace(cam.center, d, hit);
+                gt.set(u, rig_, tracer, found, hit, d.dot(axis));
+            }
+        }
+    });
+}
+
+RenderedFrame Renderer::render(const Scene &scene, const RigPose &pose, uint64_t frame) const {
+    RenderedFrame out;
+    if (rig_.settings().ideal()) {
+        // The left imager is its own rectified image: its centre rays give the truth.
+        out.left = expose(renderRadiance(scene, rig_.left(pose), &out), 0, frame);
+    } else {
+        out.left = expose(renderRadiance(scene, rig_.left(pose)), 0, frame);
+        renderGroundTruth(scene, rig_.rectifiedLeft(pose), out);
+    }
+    out.right = expose(renderRadiance(scene, rig_.right(pose)), 1, frame);
+    return out;
+}
+
+} // namespace binocle::sim
