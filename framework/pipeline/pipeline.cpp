@@ -2,6 +2,7 @@
 // The pipeline: acquire, rectify, match, triangulate, transform, evaluate, write.
 #include "pipeline/pipeline.hpp"
 
+#include "calibration/geometry_check.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
@@ -53,17 +54,16 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
                         rig_.source.plugin + "' publishes none (run `binocle calibrate`, or add calibration: FILE)");
         calibration_ = StereoCalibration::fromYaml(calibrationYaml_, "calibration published by source '" + rig_.source.plugin + "'");
     }
-    // Geometry check before the first frame: a calibration made for another image size
-    // or with a baseline of the wrong sign gives a collapsed cloud or negative disparities.
-    const std::string origin = rig_.calibration_file ? *rig_.calibration_file : "the calibration of source '" + rig_.source.plugin + "'";
-    if (calibration_.image_size != imageSize)
-        throw Error(origin + ": calibration is for " + std::to_string(calibration_.image_size.width) + "x" +
-                    std::to_string(calibration_.image_size.height) + " images, but the source delivers " +
-                    std::to_string(imageSize.width) + "x" + std::to_string(imageSize.height));
-    if (calibration_.T.at<double>(0) >= 0)
-        throw Error(origin + ": T.x = " + std::to_string(calibration_.T.at<double>(0)) +
-                    " mm: the right camera must be to the right of the left one (T.x < 0, x_r = R x_l + T); "
-                    "left and right are probably swapped");
+    // Geometry check before the first frame: a calibration made for another image size,
+    // with the cameras swapped or for another baseline gives a collapsed cloud or
+    // negative disparities.
+    GeometryExpectation expected;
+    expected.image_size = imageSize;
+    expected.baseline_mm = statedGeometry(rig_.source).baseline_mm;
+    expected.source = rig_.source.plugin;
+    checkGeometry(calibration_, expected,
+                  rig_.calibration_file ? "calibration " + *rig_.calibration_file
+                                        : "the calibration published by source '" + rig_.source.plugin + "'");
     if (!calibration_.rectified) {
         cv::initUndistortRectifyMap(calibration_.M1, calibration_.D1, calibration_.R1, calibration_.P1, imageSize, CV_32FC1,
                                     map1x_, map1y_);
