@@ -319,7 +319,11 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
                 Rgb sum = Rgb::Zero();
                 for (int j = 0; j < n; ++j) {
                     for (int i = 0; i < n; ++i) {
-                        const Vec3 dir = cam.direction(u - 0.5 + (i + 0.5) / n, v - 0.5 + (j + 0.5) / n), d = dir.normalized();
+                        // One sample per cell of an n x n grid, placed so that the n^2
+                        // samples take n^2 distinct columns and rows ("n-rooks"): edges
+                        // along the image axes are resolved to 1/n^2 of a pixel, not 1/n.
+                        const double x = (i + (j + 0.5) / n) / n, y = (j + (i + 0.5) / n) / n;
+                        const Vec3 dir = cam.direction(u - 0.5 + x, v - 0.5 + y), d = dir.normalized();
                         Tracer::Hit hit;
                         sum += tracer.trace(cam.center, d, hit) ? tracer.shade(cam.center, d, hit, dir, subX, subY)
                                                                  : tracer.sky(d);
