@@ -2,9 +2,8 @@
 // The sim source plugin through the host: settings, frames, extras, metadata,
 // calibration, end of stream, errors, and cv::StereoSGBM against its ground truth.
 #include "common/test_util.hpp"
-#include "config/rig_config.hpp"
 #include "core/calibration.hpp"
-#include "host/plugin_host.hpp"
+#include "plugins_matchers/plugin_fixtures.hpp" // builtPlugins(), errorOf()
 
 #include <binocle/abi.h>
 
@@ -18,28 +17,12 @@
 namespace binocle::test {
 namespace {
 
-const PluginRecord &simRecord() {
-    static const std::unique_ptr<PluginHost> host = [] {
-        auto h = std::make_unique<PluginHost>(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR});
-        h->scan();
-        return h;
-    }();
-    return host->require("sim", BINOCLE_KIND_STEREO_SOURCE);
-}
+const PluginRecord &simRecord() { return builtPlugins().require("sim", BINOCLE_KIND_STEREO_SOURCE); }
 
 std::unique_ptr<Source> makeSim(const std::string &yaml = "{}") {
     auto s = std::make_unique<Source>(simRecord(), paramsFromYaml(simRecord(), yaml));
     s->start();
     return s;
-}
-
-std::string errorOf(const std::function<void()> &f) {
-    try {
-        f();
-    } catch (const std::exception &e) {
-        return e.what();
-    }
-    return "";
 }
 
 TEST(SimPlugin, DefaultFrameIsTheVidereHeadBeforeTheE1Panel) {
