@@ -69,6 +69,9 @@ struct HostSink {
 // Common part of the instance wrappers.
 class PluginInstanceBase {
 public:
+    // One wrapper per plugin instance: a copy would destroy the instance twice.
+    PluginInstanceBase(const PluginInstanceBase &) = delete;
+    PluginInstanceBase &operator=(const PluginInstanceBase &) = delete;
     const PluginRecord &record() const { return record_; }
     // Replaces where this instance's metrics and logs go (default: log to stderr).
     void setSink(HostSink sink);

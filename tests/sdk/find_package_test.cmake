@@ -3,7 +3,8 @@
 #  1. install the SDK component of this build into a fresh prefix; only public files land
 #  2. configure a copy of find_package_test/ with CMAKE_PREFIX_PATH = that prefix alone,
 #     and check it used the installed package, never the source tree
-#  3. build and install the plugin (it goes to the SDK's BINOCLE_PLUGIN_DIR)
+#  3. build the plugin (it exports binocle_plugin_init alone) and install it (into the
+#     SDK's BINOCLE_PLUGIN_DIR)
 #  4. the built `binocle` accepts it with --load and from the installed plugin folder
 #  5. `binocle run` uses it in a rig fed by the mock_source test fixture
 # Inputs (-D): BUILD_DIR SOURCE_DIR PROJECT_DIR WORK_DIR CLI TEST_PLUGIN_DIR GENERATOR CXX_COMPILER
@@ -73,6 +74,16 @@ run_step("building the out-of-tree plugin" "${CMAKE_COMMAND}" --build "${build}"
 file(GLOB_RECURSE built "${build}/binocle_external_matcher.so")
 if(NOT built)
   message(FATAL_ERROR "no binocle_external_matcher.so in ${build}")
+endif()
+# binocle_add_plugin() from the package exports the init symbol and nothing else.
+find_program(NM nm)
+if(NM)
+  run_step("listing the plugin's exported symbols" "${NM}" -D --defined-only "${built}")
+  string(REGEX MATCHALL "[^\n]* [TtWwVvDdBbRrUui] [^\n]+" symbols "${step_output}")
+  string(REGEX REPLACE "[^;]* [A-Za-z] " "" names "${symbols}")
+  if(NOT names STREQUAL "binocle_plugin_init")
+    message(FATAL_ERROR "the out-of-tree plugin exports more than binocle_plugin_init: ${names}")
+  endif()
 endif()
 run_step("installing the out-of-tree plugin" "${CMAKE_COMMAND}" --install "${build}")
 file(GLOB_RECURSE plugin_installed "${prefix}/*/binocle_external_matcher.so")
