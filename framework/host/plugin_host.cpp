@@ -165,7 +165,15 @@ std::vector<std::string> PluginHost::defaultSearchPath() {
         // No program location (unusual); the other entries still apply.
     }
     path.emplace_back(BINOCLE_BUILD_PLUGIN_DIR);
-    return path;
+    // The build tree mirrors the install layout: drop a folder named twice.
+    std::vector<std::string> unique;
+    for (const auto &d : path) {
+        std::error_code ec;
+        const std::string c = fs::weakly_canonical(d, ec).string();
+        if (std::none_of(unique.begin(), unique.end(), [&](const std::string &u) { return fs::weakly_canonical(u, ec).string() == c; }))
+            unique.push_back(d);
+    }
+    return unique;
 }
 
 PluginHost::PluginHost(std::vector<std::string> searchPath) : searchPath_(std::move(searchPath)) {}

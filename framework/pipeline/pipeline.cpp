@@ -29,6 +29,7 @@ Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
         EvaluatorSlot *raw = slot.get();
         HostSink sink;
         sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
+            if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
             if (!raw->target) return;
             raw->target->set(name, value);
             if (!unit.empty()) raw->target->set(name + "_unit", unit);
@@ -120,13 +121,16 @@ FrameResult Pipeline::process(const LentFrame &frame) {
         for (auto &slot : evaluators_) {
             Json figures = Json::object();
             slot->target = &figures;
+            slot->flat = &r.figures;
             try {
                 slot->evaluator->evaluate(in);
             } catch (...) {
                 slot->target = nullptr;
+                slot->flat = nullptr;
                 throw;
             }
             slot->target = nullptr;
+            slot->flat = nullptr;
             r.metrics.set(slot->name, std::move(figures));
         }
     }

@@ -30,6 +30,7 @@ struct FrameResult {
     cv::Mat disparity; // CV_32F
     Cloud cloud;       // after transforms
     Json metrics;      // {evaluator: {metric: value}}
+    std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
     double seconds = 0;
 };
 
@@ -58,6 +59,7 @@ private:
         std::string name;
         std::unique_ptr<Evaluator> evaluator;
         Json *target = nullptr; // where its figures go right now
+        std::vector<std::pair<std::string, double>> *flat = nullptr;
     };
     std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
     StereoCalibration calibration_;
