@@ -39,10 +39,11 @@ TEST(PluginLoading, RefusesExactlyTheBrokenFixtures) {
         EXPECT_FALSE(r.reason.empty()) << r.path;
     }
     std::sort(refused.begin(), refused.end());
-    EXPECT_EQ(refused, (std::vector<std::string>{"binocle_init_null.so", "binocle_mock_matcher_duplicate.so",
+    EXPECT_EQ(refused, (std::vector<std::string>{"binocle_bad_name.so", "binocle_bad_params.so", "binocle_init_null.so",
+                                                 "binocle_init_throws.so", "binocle_mock_matcher_duplicate.so",
                                                  "binocle_no_init.so", "binocle_null_entries.so",
                                                  "binocle_short_table.so", "binocle_small_header.so",
-                                                 "binocle_wrong_abi.so"}));
+                                                 "binocle_unknown_kind.so", "binocle_wrong_abi.so"}));
 }
 
 TEST(PluginLoading, WrongAbiNamesBothVersions) {
@@ -97,6 +98,20 @@ TEST(PluginLoading, DuplicateNameIsRefusedNamingTheFirstFile) {
     ASSERT_NE(kept, nullptr);
     EXPECT_EQ(kept->path, fixturePath("mock_matcher"));
     EXPECT_EQ(kept->version, "1.0.0"); // not the duplicate's 9.9.9
+}
+
+TEST(PluginLoading, InitThrowingIsRefusedWithoutTerminating) {
+    EXPECT_THAT(refusalOf("init_throws"), HasSubstr("init symbol threw an exception"));
+}
+
+TEST(PluginLoading, InvalidNameIsRefused) {
+    EXPECT_THAT(refusalOf("bad_name"), HasSubstr("invalid plugin name 'Bad-Name' (expected [a-z0-9_]+)"));
+}
+
+TEST(PluginLoading, UnknownKindIsRefused) { EXPECT_THAT(refusalOf("unknown_kind"), HasSubstr("unknown plugin kind 99")); }
+
+TEST(PluginLoading, GarbageSettingsTableIsRefused) {
+    EXPECT_THAT(refusalOf("bad_params"), HasSubstr("garbage settings table (count -1)"));
 }
 
 TEST(PluginLoading, RequireOfARefusedPluginGivesTheReason) {
