@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// Design figures of a stereo head before any hardware is assembled: the form factor
+// (METHOD.md Eq. 7) and the sensor-aware figures reported beside it.
+#pragma once
+
+namespace binocle::method {
+
+// Eq. 7: FF = 10 * B * f / R, with baseline B, focal length f and range R all in mm.
+double formFactor(double baseline_mm, double focal_length_mm, double range_mm);
+// Eq. 7 solved for f: the focal length (mm) that gives form factor `ff` at range R.
+double focalLengthForFormFactor(double ff, double baseline_mm, double range_mm);
+// METHOD.md's reading of FF: "low" (< 1.0), "fair" (1.0-1.2), "best" (1.2-2.0), "high" (> 2.0).
+const char *formFactorReading(double ff);
+
+// Disparity law: d = B * f / (R * p) pixels, with the pixel pitch p in um.
+double expectedDisparityPx(double baseline_mm, double focal_length_mm, double range_mm, double pixel_pitch_um);
+// Depth resolution: dR = R^2 * p * dd / (B * f) mm for a matching error dd (px).
+double depthResolutionMm(double baseline_mm, double focal_length_mm, double range_mm, double pixel_pitch_um,
+                         double matching_error_px);
+// Nearest range the matcher can see: a search over disparities min_d .. min_d + N - 1
+// finds at most d_max = min_d + N - 1, so R_min = B * f / (p * d_max). NaN when
+// d_max < 1 (no search known).
+double minimumRangeMm(double baseline_mm, double focal_length_mm, double pixel_pitch_um, int min_disparity_px,
+                      int num_disparities);
+// Angle a row (or column) of `pixels` pixels of pitch p sees: 2 * atan(N * p / (2 f)), degrees.
+double fieldOfViewDeg(int pixels, double pixel_pitch_um, double focal_length_mm);
+// Width the same pixels cover at range R (mm): R * N * p / f.
+double fieldWidthMm(double range_mm, int pixels, double pixel_pitch_um, double focal_length_mm);
+
+// A stereo head: what Eq. 7 and the figures need. Lengths in mm, pitch in um.
+struct StereoDesign {
+    double baseline_mm = 0;
+    double focal_length_mm = 0;
+    double pixel_pitch_um = 0;    // effective pitch of an image pixel (after decimation)
+    int image_width_px = 0, image_height_px = 0;
+    int min_disparity_px = 0;     // the matcher's search; num_disparities 0 = unknown
+    int num_disparities = 0;
+    double camera_height_mm = 1500; // hc and theta of Eq. 1, for the vertical field
+    double inclination_deg = 0;
+
+    double focalLengthPx() const { return focal_length_mm * 1000.0 / pixel_pitch_um; }
+};
+
+// A test panel standing in the field of view (ground frame, mm).
+struct PanelPlacement {
+    double width_mm = 2500, height_mm = 2000;
+    double center_x_mm = 0; // lateral position of its middle
+    double base_z_mm = 0;   // height of its lower edge
+};
+
+struct DesignFigures {
+    double range_mm = 0;
+    double form_factor = 0;           // Eq. 7
+    double disparity_px = 0;          // d at R
+    double matching_error_px = 0;     // dd used for depth_resolution_mm
+    double depth_resolution_mm = 0;   // dR at R
+    double min_range_mm = 0;          // NaN when the search is unknown
+    double horizontal_fov_deg = 0, vertical_fov_deg = 0; // NaN when the image size is unknown
+    double field_width_mm = 0;        // what the left imager covers at R
+    // Lateral band at R seen by both imagers and searched by the matcher: the left
+    // imager's field less max(B, the search's blind columns at R) on the left.
+    double stereo_field_min_x_mm = 0, stereo_field_max_x_mm = 0;
+    double stereo_field_width_mm = 0;
+    double field_bottom_z_mm = 0, field_top_z_mm = 0; // heights the left imager sees at R
+    // With a panel: does it fit, and which part of the stereo field it fills.
+    bool panel_given = false;
+    bool panel_fits_width = false, panel_fits_height = false;
+    double panel_width_ratio = 0;     // panel width / stereo field width
+    double panel_height_ratio = 0;    // panel height / field height at R
+};
+
+// All figures of `design` at range R. Values that need a missing input (image size,
+// disparity search) are NaN. Throws std::invalid_argument when B, f, p or R is not positive.
+DesignFigures designFigures(const StereoDesign &design, double range_mm, double matching_error_px = 0.25,
+                            const PanelPlacement *panel = nullptr);
+
+} // namespace binocle::method
