@@ -3,6 +3,7 @@
 #include "cli/command.hpp"
 #include "host/plugin_host.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 
@@ -18,8 +19,10 @@ int run(const Args &args) {
     for (const auto &d : host.searchPath()) std::cout << "  " << d << "\n";
     std::cout << "\nplugins (host ABI " << BINOCLE_ABI_VERSION << ", API " << BINOCLE_API_VERSION << "):\n";
     if (host.plugins().empty()) std::cout << "  none\n";
+    size_t nameWidth = 12;
+    for (const auto &p : host.plugins()) nameWidth = std::max(nameWidth, p.name.size() + 2);
     for (const auto &p : host.plugins()) {
-        std::cout << "  " << std::left << std::setw(12) << p.name << std::setw(10) << kindName(p.kind) << std::setw(9)
+        std::cout << "  " << std::left << std::setw(static_cast<int>(nameWidth)) << p.name << std::setw(10) << kindName(p.kind) << std::setw(9)
                   << p.version << "ABI " << p.abi_version << " API " << p.api_version << "  " << p.description << "\n";
         if (verbose) {
             std::cout << "      file: " << p.path << "\n";

@@ -37,6 +37,10 @@ struct Command {
 
 const std::map<std::string, Command> &commands();
 
+// A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
+// next to the executable, else from the source tree it was built from.
+std::string dataFile(const std::string &relative);
+
 struct Register {
     explicit Register(Command c);
 };

@@ -6,6 +6,7 @@
 #include <binocle/abi.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
 
 namespace binocle::cli {
@@ -18,6 +19,14 @@ std::map<std::string, Command> &registry() {
 } // namespace
 
 const std::map<std::string, Command> &commands() { return registry(); }
+
+std::string dataFile(const std::string &relative) {
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const auto installed = exe.parent_path().parent_path() / BINOCLE_DATA_INSTALL_DIR / relative;
+    if (!ec && std::filesystem::exists(installed)) return installed.string();
+    return (std::filesystem::path(BINOCLE_SOURCE_DIR) / relative).string();
+}
 
 Register::Register(Command c) { registry()[c.name] = std::move(c); }
 

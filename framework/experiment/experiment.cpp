@@ -285,6 +285,31 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
     return e;
 }
 
+Experiment makeExperiment(const std::string &name, const std::string &rig_file, const std::vector<TestGeometry> &tests,
+                          const PluginHost &host) {
+    Experiment e;
+    std::error_code ec;
+    e.name = name;
+    e.file = "(" + name + ")";
+    e.rig_file = fs::absolute(rig_file, ec).lexically_normal().string();
+    if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
+    try {
+        e.rig = YAML::LoadFile(e.rig_file);
+    } catch (const YAML::Exception &x) {
+        throw Error(e.rig_file + ": cannot read YAML: " + x.msg);
+    }
+    e.bind = defaultBind(e.rig);
+    for (size_t i = 0; i < tests.size(); ++i) {
+        ExperimentTest t;
+        t.id = std::to_string(i + 1);
+        t.geometry = tests[i];
+        rigFromNode(rigForTest(e, t), e.rig_file, host); // throws with the reason
+        e.tests.push_back(t);
+    }
+    e.charts = {{"scatter", "eta_3d_percent", "form_factor", name + ": η3D against the form factor FF", "eta_3d_vs_ff", {}}};
+    return e;
+}
+
 namespace {
 
 // Main columns first (the names of METHOD.md), then every other figure an evaluator

@@ -61,6 +61,11 @@ struct Experiment {
 // plugins `host` found. Throws binocle::Error with file, line and reason; nothing runs.
 Experiment loadExperiment(const std::string &file, const PluginHost &host);
 
+// An experiment made in code: the base rig file and one test per geometry (ids 1, 2 ...),
+// bound to the rig the same way as a file without `bind:`. Validated like a file.
+Experiment makeExperiment(const std::string &name, const std::string &rig_file, const std::vector<TestGeometry> &tests,
+                          const PluginHost &host);
+
 // The rig of one test: the base rig with the test's variables and overrides applied.
 YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t);
 

@@ -203,8 +203,8 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     int64_t count = 0;
     std::string failure;
     auto writeSummary = [&]() {
-        if (outDir_.empty()) return;
         summary.set("frames", frames);
+        if (outDir_.empty()) return;
         writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump());
     };
     try {
