@@ -144,4 +144,23 @@ ObjectOffset objectOffset(const std::vector<LocalisedObject> &objects, const Kno
     return best;
 }
 
+ObjectOffset locateKnownObject(const CloudView &cloud, const KnownObject &truth, PanelReadingOptions options,
+                               double lateral_margin_mm) {
+    ObjectOffset off;
+    off.true_x_mm = truth.center_mm[0];
+    off.true_range_mm = truth.nearFaceRangeMm();
+    const double half = truth.size_mm[0] / 2 + lateral_margin_mm;
+    options.lateral = {off.true_x_mm - half, off.true_x_mm + half};
+    options.expected_range_mm = off.true_range_mm;
+    const PanelReading r = readPanel(cloud, options);
+    if (!r.registered) return off;
+    off.found = true;
+    off.measured_x_mm = (r.x_min_mm + r.x_max_mm) / 2;
+    off.measured_range_mm = r.range_mm;
+    off.lateral_mm = off.measured_x_mm - off.true_x_mm;
+    off.range_mm = off.measured_range_mm - off.true_range_mm;
+    off.distance_mm = std::hypot(off.lateral_mm, off.range_mm);
+    return off;
+}
+
 } // namespace binocle::method

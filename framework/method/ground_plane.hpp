@@ -6,6 +6,7 @@
 
 #include "method/cloud_view.hpp"
 #include "method/density_grid.hpp"
+#include "method/panel.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -68,6 +69,15 @@ struct ObjectOffset {
     double measured_x_mm = 0, measured_range_mm = 0;
     double true_x_mm = 0, true_range_mm = 0;
 };
+
+// Reads a known object where it should be, as the E1 panel is read (readPanel): the
+// points above the ground within its true lateral span +- lateral_margin_mm, the densest
+// range band near its near face (options' range search and margin), the lateral edges
+// of the band's occupied front-view cells and the median range. Robust where the top
+// view's regions merge (a smeared cloud joining the object to its neighbours).
+// options.expected_range_mm and options.lateral are set from `truth`.
+ObjectOffset locateKnownObject(const CloudView &cloud, const KnownObject &truth, PanelReadingOptions options,
+                               double lateral_margin_mm);
 
 // Matches `truth` to the nearest localised object (by lateral centre and range) within
 // max_distance_mm; found = false when none is that close.

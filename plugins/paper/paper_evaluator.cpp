@@ -107,8 +107,8 @@ public:
                 .help("e2: true centre [X, Y, Z] of the known object when the metadata has none"),
             Param::realList("object_size_mm", "[]").unit("mm")
                 .help("e2: true size [width, depth, height] of the known object when the metadata has none"),
-            Param::real("object_match_mm", "1500").min(0).unit("mm")
-                .help("e2: farthest a localised object may be from the known one to be it"),
+            Param::real("object_margin_mm", "500").min(0).unit("mm")
+                .help("e2: the known object is read within its true lateral span +- this"),
             Param::real("true_inclination_deg", "0").min(-90).max(90).unit("deg")
                 .help("e2: the camera's true inclination; unset: the metadata's rig.inclination_deg"),
             Param::real("ground_inlier_mm", "50").min(1).unit("mm").help("e2: RANSAC inlier distance to the ground plane"),
@@ -167,7 +167,7 @@ public:
             drawings.top.push_back({{o.x_min_mm, o.x_max_mm}, {o.y_min_mm, o.y_max_mm}, "#" + std::to_string(o.id), {150, 90, 30}});
         double range = kNaN;
         std::optional<method::PanelPlacement> panel;
-        if (e2_) range = evaluateE2(cloud, truth, objects, drawings);
+        if (e2_) range = evaluateE2(cloud, truth, drawings);
         else range = evaluatePanel(cloud, truth, drawings, panel);
         reportDesign(truth, range, panel ? &*panel : nullptr);
         if (p_.boolean("write_views")) writeViews(cloud, in.output_dir, drawings);
@@ -268,7 +268,7 @@ private:
     }
 
     double evaluateE2(const method::CloudView &cloud, const paper::FrameTruth &truth,
-                      const std::vector<method::LocalisedObject> &objects, Drawings &drawings) {
+                      Drawings &drawings) {
         // The known object.
         method::KnownObject known;
         const std::string name = objectName_.empty() ? truth.main_object : objectName_;
@@ -292,10 +292,15 @@ private:
                         "paper (experiment e2): no known object" + (name.empty() ? std::string() : " named '" + name + "'") +
                             " in the frame metadata: set `object` to the name of one of its objects, or "
                             "object_center_mm and object_size_mm");
-        const method::ObjectOffset off = method::objectOffset(objects, known, p_.real("object_match_mm"));
+        method::PanelReadingOptions o;
+        o.grid = grid_;
+        o.range_search_percent = p_.real("range_search_percent");
+        o.range_margin_mm = p_.real("range_margin_mm");
+        o.min_points = p_.integer("min_panel_points");
+        const method::ObjectOffset off = method::locateKnownObject(cloud, known, o, p_.real("object_margin_mm"));
         if (!off.found)
             host_.warning("frame " + std::to_string(sequence_) + ": known object '" + known.name +
-                          "' not found within " + fixed(p_.real("object_match_mm"), 0) + " mm of where it is");
+                          "' not found within " + fixed(p_.real("object_margin_mm"), 0) + " mm of its lateral span");
         metric("registered", off.found ? 1 : 0);
         metric("epsilon_y_percent",
                off.found ? method::relativeErrorPercent(off.measured_range_mm, off.true_range_mm) : kNaN, "%"); // Eq. 3
@@ -304,11 +309,9 @@ private:
         metric("object_offset_lateral_mm", off.found ? off.lateral_mm : kNaN, "mm");
         metric("object_offset_range_mm", off.found ? off.range_mm : kNaN, "mm");
         if (off.found)
-            for (method::ViewOverlay &o : drawings.top)
-                if (o.label == "#" + std::to_string(off.object_id)) {
-                    o.label += " " + known.name;
-                    o.color = {40, 40, 220};
-                }
+            drawings.top.push_back({{off.measured_x_mm - known.size_mm[0] / 2, off.measured_x_mm + known.size_mm[0] / 2},
+                                    {off.measured_range_mm, off.measured_range_mm + known.size_mm[1]},
+                                    known.name, {40, 40, 220}});
 
         // The ground plane, and the inclination it gives back (Eq. 1 applied with the
         // ground transform's inclination).

@@ -103,5 +103,32 @@ TEST(ObjectOffset, LateralAndRangeOffsetsOfAKnownObject) {
     EXPECT_FALSE(objectOffset(objects, marker, 50).found); // farther than allowed
 }
 
+// A smeared cloud joins the marker to a big object behind it in the top view: the
+// object is still read where it should be.
+TEST(ObjectOffset, KnownObjectReadWhereItShouldBe) {
+    CloudBuilder b(12);
+    b.frontFace(-1250 + 60, -750 + 60, 0, 500, 6000 + 90, 10, 3);  // the marker, offset
+    b.topFace(-1250 + 60, -750 + 60, 6090, 6590, 500, 20, 3);       // its top
+    b.frontFace(600, 1800, 0, 3000, 9000, 20, 5);                   // a trunk and crown behind
+    b.topFace(-1000, 1200, 6600, 9000, 300, 30, 5);                  // smear joining them (a sheet)
+    b.ground(-5000, 5000, 1000, 15000, 100, 5);
+    KnownObject marker;
+    marker.center_mm[0] = -1000;
+    marker.center_mm[1] = 6250;
+    marker.center_mm[2] = 250;
+    marker.size_mm[0] = marker.size_mm[1] = marker.size_mm[2] = 500;
+    GridSpec spec;
+    const std::vector<LocalisedObject> objects = localiseObjects(CloudView(b.xyz), spec);
+    EXPECT_FALSE(objectOffset(objects, marker, 300).found); // merged with the rest in the top view
+    PanelReadingOptions o;
+    const ObjectOffset off = locateKnownObject(CloudView(b.xyz), marker, o, 500);
+    ASSERT_TRUE(off.found);
+    EXPECT_NEAR(off.lateral_mm, 60, 10);
+    EXPECT_NEAR(off.range_mm, 90, 5);
+    SyntheticScene empty;
+    empty.panel = false;
+    EXPECT_FALSE(locateKnownObject(CloudView(panelScene(empty)), marker, o, 500).found);
+}
+
 } // namespace
 } // namespace binocle::test
