@@ -1,0 +1,310 @@
+// SPDX-License-Identifier: MIT
+// Tests of `binocle record` and the recording writer: what is recorded replays bit for bit,
+// a recorder killed mid-run leaves a readable recording, nothing is ever overwritten.
+#include "../common/test_util.hpp"
+
+#include "config/rig_config.hpp"
+#include "core/error.hpp"
+#include "host/plugin_host.hpp"
+#include "pipeline/recorder.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+using binocle::Source;
+using binocle::test::TempDir;
+
+binocle::PluginHost &host() {
+    static binocle::PluginHost h(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR});
+    static const bool scanned = (h.scan(), true);
+    (void)scanned;
+    return h;
+}
+
+bool haveSim() { return host().find("sim", BINOCLE_KIND_STEREO_SOURCE) != nullptr; }
+
+std::string readFile(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+int countLines(const std::string &path) {
+    std::ifstream in(path);
+    int n = 0;
+    for (std::string line; std::getline(in, line);) ++n;
+    return n;
+}
+
+struct Frame {
+    cv::Mat left, right;
+    int64_t tl = 0, tr = 0;
+};
+
+// Every frame a source gives (at most `max`), deep-copied.
+std::vector<Frame> framesOf(const binocle::PluginRecord &record, const std::string &yaml, int max = 1000) {
+    Source s(record, binocle::paramsFromYaml(record, yaml));
+    s.start();
+    std::vector<Frame> out;
+    while (static_cast<int>(out.size()) < max) {
+        auto f = s.grab(5000);
+        if (!f) break;
+        out.push_back({f->left().clone(), f->right().clone(), f->raw().timestamp_left_ns, f->raw().timestamp_right_ns});
+    }
+    return out;
+}
+
+std::vector<Frame> replayOf(const std::string &folder, const std::string &color) {
+    return framesOf(host().require("replay", BINOCLE_KIND_STEREO_SOURCE), "{folder: " + folder + ", color: " + color + "}");
+}
+
+bool same(const cv::Mat &a, const cv::Mat &b) {
+    return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
+}
+
+// Colour pairs on disk, played by replay's glob layout.
+void writeColourPairs(const TempDir &dir, int n) {
+    fs::create_directories(dir.path() / "in");
+    for (int i = 0; i < n; ++i) {
+        cv::Mat l(90, 120, CV_8UC3), r(90, 120, CV_8UC3);
+        cv::RNG rng(static_cast<uint64_t>(i) + 11);
+        rng.fill(l, cv::RNG::UNIFORM, 0, 256);
+        rng.fill(r, cv::RNG::UNIFORM, 0, 256);
+        cv::imwrite(dir.str("in/left_" + std::to_string(i) + ".png"), l);
+        cv::imwrite(dir.str("in/right_" + std::to_string(i) + ".png"), r);
+    }
+}
+
+std::string replayRig(const TempDir &dir, const std::string &extra = "") {
+    return "name: colour-files\nsource:\n  plugin: replay\n  left: in/left_*.png\n  right: in/right_*.png\n  rate_hz: 30\n" + extra +
+           "matcher: {plugin: sgbm}\n";
+}
+
+const char *kSimSettings = "  image_width: 160\n  image_height: 120\n  forward_mm_per_frame: 100\n  color: gray\n  seed: 3\n";
+
+std::string simRig(int frames) {
+    return "name: sim-record\nsource:\n  plugin: sim\n" + std::string(kSimSettings) + "  frames: " + std::to_string(frames) +
+           "\nmatcher: {plugin: sgbm}\n";
+}
+
+void expectSameFrames(const std::vector<Frame> &a, const std::vector<Frame> &b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_TRUE(same(a[i].left, b[i].left)) << "frame " << i << " left";
+        EXPECT_TRUE(same(a[i].right, b[i].right)) << "frame " << i << " right";
+        EXPECT_EQ(a[i].tl, b[i].tl) << "frame " << i;
+        EXPECT_EQ(a[i].tr, b[i].tr) << "frame " << i;
+    }
+}
+
+TEST(Record, SimRecordingReplaysBitForBit) {
+    if (!haveSim()) GTEST_SKIP() << "sim plugin not built";
+    TempDir dir;
+    binocle::test::writeText(dir.str("rig.yaml"), simRig(4));
+    const auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("4 frame(s) of rig 'sim-record' recorded"), std::string::npos) << r.output;
+    EXPECT_EQ(countLines(dir.str("rec/frames.csv")), 5);
+    EXPECT_EQ(readFile(dir.str("rec/frames.csv")).substr(0, 57), "sequence,timestamp_left_ns,timestamp_right_ns,left,right\n");
+    EXPECT_TRUE(fs::exists(dir.str("rec/left/000003.png")));
+    EXPECT_TRUE(fs::exists(dir.str("rec/rig.yaml")));
+
+    const auto &sim = host().require("sim", BINOCLE_KIND_STEREO_SOURCE);
+    const std::string settings = "{image_width: 160, image_height: 120, forward_mm_per_frame: 100, color: gray, seed: 3, frames: 4}";
+    const auto original = framesOf(sim, settings);
+    expectSameFrames(original, replayOf(dir.str("rec"), "gray"));
+    // The calibration is the simulated rig's own, verbatim.
+    Source s(sim, binocle::paramsFromYaml(sim, settings));
+    EXPECT_EQ(readFile(dir.str("rec/calibration.yml")), s.calibration());
+}
+
+TEST(Record, ColourReplaySourceRecordingReplaysBitForBit) {
+    TempDir dir;
+    writeColourPairs(dir, 3);
+    binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir));
+    const auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto &replay = host().require("replay", BINOCLE_KIND_STEREO_SOURCE);
+    const auto original = framesOf(replay, "{left: " + dir.str("in/left_*.png") + ", right: " + dir.str("in/right_*.png") + ", rate_hz: 30}");
+    ASSERT_EQ(original.size(), 3u);
+    EXPECT_EQ(original[0].left.type(), CV_8UC3);
+    expectSameFrames(original, replayOf(dir.str("rec"), "bgr"));
+    // The rig as resolved, --set included, lies beside the frames.
+    EXPECT_NE(readFile(dir.str("rec/rig.yaml")).find("plugin: replay"), std::string::npos);
+}
+
+TEST(Record, FramesAndSetOptionsAndTheRigsCalibration) {
+    TempDir dir;
+    writeColourPairs(dir, 3);
+    const std::string calibration = std::string(BINOCLE_SOURCE_DIR) + "/configs/calibrations/opencv-aloe-ideal.yml";
+    binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir) + "calibration: " + calibration + "\n");
+    const auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") +
+                                         " --frames 5 --set source.loop=true --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(countLines(dir.str("rec/frames.csv")), 6);
+    EXPECT_EQ(readFile(dir.str("rec/calibration.yml")), readFile(calibration));
+    EXPECT_NE(readFile(dir.str("rec/rig.yaml")).find("loop: true"), std::string::npos);
+    EXPECT_EQ(replayOf(dir.str("rec"), "bgr").size(), 5u);
+}
+
+TEST(Record, RefusesAFolderThatHoldsAnythingAndLosesNothing) {
+    TempDir dir;
+    writeColourPairs(dir, 2);
+    binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir));
+    fs::create_directories(dir.path() / "busy");
+    binocle::test::writeText(dir.str("busy/notes.txt"), "keep me");
+    auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("busy"));
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(dir.str("busy") + " is not empty (it holds notes.txt): refusing to record over it"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(readFile(dir.str("busy/notes.txt")), "keep me");
+    EXPECT_FALSE(fs::exists(dir.str("busy/frames.csv")));
+
+    // A finished recording is never touched by a second run.
+    ASSERT_EQ(binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") + " --quiet").exit_code, 0);
+    const std::string before = readFile(dir.str("rec/frames.csv"));
+    const std::string image = readFile(dir.str("rec/left/000000.png"));
+    r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") + " --quiet");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("refusing to record over it"), std::string::npos) << r.output;
+    EXPECT_EQ(readFile(dir.str("rec/frames.csv")), before);
+    EXPECT_EQ(readFile(dir.str("rec/left/000000.png")), image);
+
+    // An empty folder is fine.
+    fs::create_directories(dir.path() / "empty");
+    EXPECT_EQ(binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("empty") + " --quiet").exit_code, 0);
+}
+
+TEST(Record, CommandLineErrorsSayWhatIsWrong) {
+    TempDir dir;
+    writeColourPairs(dir, 1);
+    binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir));
+    auto r = binocle::test::runCli("record " + dir.str("rig.yaml"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("missing --out DIR"), std::string::npos) << r.output;
+    r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("x") + " --frames 0");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("--frames = 0"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir.str("x")));
+}
+
+// Starts `binocle record` as a child process; returns its pid.
+pid_t spawnRecorder(const std::string &rig, const std::string &out) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::setenv("BINOCLE_PLUGIN_PATH", BINOCLE_BUILD_PLUGIN_DIR, 1);
+        const int devnull = ::open("/dev/null", O_WRONLY);
+        ::dup2(devnull, 2);
+        ::execl(BINOCLE_CLI, BINOCLE_CLI, "record", rig.c_str(), "--out", out.c_str(), "--quiet", static_cast<char *>(nullptr));
+        ::_exit(127);
+    }
+    return pid;
+}
+
+TEST(Record, KilledRecorderLeavesARecordingReadableToItsLastFrame) {
+    TempDir dir;
+    if (haveSim()) {
+        binocle::test::writeText(dir.str("rig.yaml"), simRig(0)); // endless
+    } else {
+        writeColourPairs(dir, 3);
+        binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir, "  loop: true\n"));
+    }
+    const std::string color = haveSim() ? "gray" : "bgr";
+    std::vector<Frame> original;
+    // Killed without warning at several moments, while it is busy writing more frames.
+    // extraMs < 0: the moment an image of the next frame is half written (its temporary file exists).
+    const struct {
+        int frames;
+        int extraMs;
+    } moments[] = {{6, 0}, {9, 1}, {12, 3}, {15, 7}, {8, -1}, {11, -1}};
+    for (const auto &moment : moments) {
+        const std::string out = dir.str("rec" + std::to_string(moment.frames));
+        const pid_t pid = spawnRecorder(dir.str("rig.yaml"), out);
+        ASSERT_GT(pid, 0);
+        const auto t0 = std::chrono::steady_clock::now();
+        while (countLines(out + "/frames.csv") < 1 + moment.frames && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        if (moment.extraMs >= 0) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(moment.extraMs));
+        } else {
+            const auto t1 = std::chrono::steady_clock::now();
+            auto writing = [&] {
+                for (const char *side : {"/left", "/right"})
+                    for (const auto &e : fs::directory_iterator(out + side))
+                        if (e.path().filename().string().rfind(".tmp-", 0) == 0) return true;
+                return false;
+            };
+            while (!writing() && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(5)) {
+            }
+        }
+        ::kill(pid, SIGKILL);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        ASSERT_TRUE(WIFSIGNALED(status));
+        const int lines = countLines(out + "/frames.csv") - 1;
+        ASSERT_GE(lines, moment.frames);
+
+        const auto replayed = replayOf(out, color);
+        EXPECT_EQ(static_cast<int>(replayed.size()), lines) << "every frame with its line must replay";
+        if (original.size() < replayed.size()) {
+            if (haveSim())
+                original = framesOf(host().require("sim", BINOCLE_KIND_STEREO_SOURCE),
+                                    "{image_width: 160, image_height: 120, forward_mm_per_frame: 100, color: gray, seed: 3, frames: 0}",
+                                    static_cast<int>(replayed.size()));
+            else
+                original = framesOf(host().require("replay", BINOCLE_KIND_STEREO_SOURCE),
+                                    "{left: " + dir.str("in/left_*.png") + ", right: " + dir.str("in/right_*.png") +
+                                        ", rate_hz: 30, loop: true}",
+                                    static_cast<int>(replayed.size()));
+        }
+        for (size_t i = 0; i < replayed.size(); ++i) {
+            EXPECT_TRUE(same(replayed[i].left, original[i].left)) << "frame " << i;
+            EXPECT_TRUE(same(replayed[i].right, original[i].right)) << "frame " << i;
+        }
+        int leftovers = 0, images = 0;
+        for (const auto &e : fs::recursive_directory_iterator(out)) {
+            const std::string name = e.path().filename().string();
+            if (name.rfind(".tmp-", 0) == 0) ++leftovers;
+            else if (e.path().extension() == ".png") ++images;
+        }
+        std::cout << "[ figures  ] recorder killed "
+                  << (moment.extraMs < 0 ? std::string("while writing an image") : std::to_string(moment.extraMs) + " ms")
+                  << " after frame " << moment.frames << ": " << lines
+                  << " frame(s) in frames.csv, " << replayed.size() << " replayed bit for bit (" << images << " images, "
+                  << leftovers << " temporary file(s) of the frame being written)\n";
+    }
+}
+
+TEST(RecordingWriter, WritesTheLayoutReplayReads) {
+    TempDir dir;
+    {
+        binocle::RecordingWriter w(dir.str("rec"), "%YAML:1.0\n---\nimage_width: 8\n", "name: x\n");
+        cv::Mat l(4, 8, CV_8UC1, cv::Scalar(7)), r(4, 8, CV_8UC1, cv::Scalar(9));
+        w.append(17, 1000, 1001, l, r);
+        w.append(19, 2000, 2002, l, r);
+        EXPECT_EQ(w.frameCount(), 2);
+    }
+    EXPECT_EQ(readFile(dir.str("rec/frames.csv")),
+              "sequence,timestamp_left_ns,timestamp_right_ns,left,right\n"
+              "17,1000,1001,left/000017.png,right/000017.png\n"
+              "19,2000,2002,left/000019.png,right/000019.png\n");
+    EXPECT_EQ(readFile(dir.str("rec/calibration.yml")), "%YAML:1.0\n---\nimage_width: 8\n");
+    EXPECT_EQ(cv::imread(dir.str("rec/right/000019.png"), cv::IMREAD_UNCHANGED).at<uint8_t>(0, 0), 9);
+    EXPECT_THROW(binocle::RecordingWriter(dir.str("rec"), "", ""), binocle::Error);
+}
+
+} // namespace
