@@ -9,7 +9,7 @@ packages=(
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli
   libdc1394-dev libv4l-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  opencv-doc util-linux
+  opencv-doc util-linux iproute2
 )
 
 missing=()

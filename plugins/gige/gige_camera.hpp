@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: MIT
+// One GigE Vision camera through Aravis: opened by device id or IP address, configured
+// from the rig's settings, streaming into buffers that the source lends without copying.
+#pragma once
+
+#include "pixel_formats.hpp"
+
+#include <arv.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+namespace binocle::gige {
+
+using Clock = std::chrono::steady_clock;
+
+// Wakes the source's grab when any stream has finished a buffer, a camera is lost or a
+// lost camera is back. Waiters pass the event count they have seen, so no wake-up is lost.
+class Notifier {
+public:
+    void notify();
+    uint64_t events();
+    // Returns when an event newer than `seen` happened, or at `until`.
+    void wait(uint64_t seen, Clock::time_point until);
+
+private:
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    uint64_t events_ = 0;
+};
+
+// Where a lent buffer goes back to: its stream while the camera is open; once the camera
+// is closed (or lost) the buffer is simply freed. Safe from any thread.
+class BufferHome {
+public:
+    explicit BufferHome(ArvStream *stream); // takes a reference
+    ~BufferHome();
+    void lend(ArvBuffer *buffer);
+    void giveBack(ArvBuffer *buffer);
+    void push(ArvBuffer *buffer); // a buffer that was never lent
+    int lent() const { return lent_.load(); }
+    // Detaches from the stream; the caller receives the stream's reference.
+    ArvStream *retire();
+
+private:
+    std::mutex mutex_;
+    ArvStream *stream_;
+    std::atomic<int> lent_{0};
+};
+
+struct CameraSettings {
+    std::string id;   // device id or IP address, as written in the YAML
+    std::string key;  // the YAML key it came from ("camera_left")
+    std::string role; // "left", "right" or "left+right"
+    const PixelFormat *format = nullptr;
+    std::optional<int64_t> width, height; // unset: keep the camera's
+    std::optional<double> exposure_us, gain_db, frame_rate_hz;
+    std::string trigger = "free_run"; // free_run | software | hardware
+    std::string trigger_line = "Line0";
+    std::optional<int64_t> packet_size;
+    bool packet_socket = false; // Aravis's AF_PACKET receiver (see README: reopening)
+    int buffers = 8;
+};
+
+struct StreamCounters {
+    uint64_t completed = 0, failed = 0, underruns = 0, missing_packets = 0, resent_packets = 0;
+    StreamCounters &operator+=(const StreamCounters &o);
+};
+
+class Camera {
+public:
+    // Opens and configures the camera; throws sdk::Error naming the camera and the value it
+    // refused. `listOnFailure`: when no camera answers, name those that do (costs a discovery).
+    Camera(const CameraSettings &settings, std::shared_ptr<Notifier> notifier, bool listOnFailure = true);
+    // Talks to the camera (AcquisitionStop) only while it answers. Closing a camera that is
+    // gone waits for Aravis's control-channel timeouts (seconds): do it away from grab.
+    ~Camera();
+    Camera(const Camera &) = delete;
+    Camera &operator=(const Camera &) = delete;
+
+    // "127.0.0.2 (left)", "Aravis-Fake-GV01 at 127.0.0.2 (left)".
+    const std::string &label() const { return label_; }
+    const std::string &address() const { return address_; }
+    const CameraSettings &settings() const { return settings_; }
+    int width() const { return width_; }
+    int height() const { return height_; }
+    const PixelFormat &format() const { return *settings_.format; }
+
+    void start(); // queues the buffers (first time) and sends AcquisitionStart
+    void stop();
+    bool acquiring() const { return acquiring_; }
+    ArvBuffer *tryPop();
+    const std::shared_ptr<BufferHome> &home() const { return home_; }
+    void softwareTrigger(); // throws sdk::Error(BINOCLE_ERR_DEVICE) when the camera does not answer
+
+    // Why the camera is considered gone (control lost, trigger unanswered); empty while fine.
+    std::string lostReason() const;
+    void markLost(const std::string &why);
+    StreamCounters counters() const;
+
+    // Every device Aravis sees, as "id (address)" list; "none" when empty. Runs a discovery.
+    static std::string listDevices();
+
+private:
+    struct LostState {
+        std::mutex mutex;
+        std::string reason;
+        std::shared_ptr<Notifier> notifier;
+    };
+    void configure();
+    [[noreturn]] void fail(int32_t code, const std::string &what) const;
+    static void onStreamEvent(void *data, ArvStreamCallbackType type, ArvBuffer *buffer);
+    static void onControlLost(ArvGvDevice *device, void *data);
+
+    CameraSettings settings_;
+    std::shared_ptr<Notifier> notifier_;
+    std::shared_ptr<LostState> lost_;
+    ArvCamera *camera_ = nullptr;
+    ArvStream *stream_ = nullptr; // reference owned by home_ once created
+    std::shared_ptr<BufferHome> home_;
+    unsigned long controlLostHandler_ = 0;
+    std::string address_, label_;
+    int width_ = 0, height_ = 0;
+    size_t payload_ = 0;
+    bool buffersQueued_ = false;
+    std::atomic<bool> acquiring_{false};
+};
+
+} // namespace binocle::gige
