@@ -4,6 +4,8 @@
 #include "fake_v4l2.hpp"
 #include "v4l2_source.hpp"
 
+#include "source_under_test.hpp"
+
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "host/plugin_host.hpp"
@@ -20,54 +22,22 @@
 #include <vector>
 
 using binocle::LentFrame;
-using binocle::PluginError;
 using binocle::Source;
+using binocle::test::Failure;
+using binocle::test::failureOf;
+using binocle::test::inside;
+using binocle::test::maxDiff;
 using namespace binocle::v4l2;
 
 namespace {
 
 fake::FakeSystem &fakes() { return fake::fakeSystem(); }
 
-// The plugin's own table, served in-process: the same code as binocle_v4l2.so, but
-// with the fake device layer linked in.
-const binocle::PluginRecord &record() {
-    static const binocle::PluginRecord r = [] {
-        binocle::PluginRecord rec;
-        rec.path = "(v4l2 logic on the fake device layer)";
-        rec.name = "v4l2";
-        rec.kind = BINOCLE_KIND_STEREO_SOURCE;
-        rec.table = &binocle::sdk::detail::sourceTable<V4l2Source>("v4l2", "test", "v4l2 on fake devices")->header;
-        rec.abi_version = rec.table->abi_version;
-        rec.api_version = rec.table->api_version;
-        return rec;
-    }();
-    return r;
-}
+const binocle::PluginRecord &record() { return binocle::test::inProcessSource<V4l2Source>("v4l2"); }
 
-std::unique_ptr<Source> make(const std::string &yaml) {
-    return std::make_unique<Source>(record(), binocle::paramsFromYaml(record(), yaml));
-}
+std::unique_ptr<Source> make(const std::string &yaml) { return binocle::test::makeSource(record(), yaml); }
 
-std::unique_ptr<Source> started(const std::string &yaml) {
-    auto s = make(yaml);
-    s->start();
-    return s;
-}
-
-struct Failure {
-    int code = BINOCLE_OK;
-    std::string message;
-};
-
-template <class F>
-Failure failureOf(F &&f) {
-    try {
-        f();
-    } catch (const PluginError &e) {
-        return {e.code(), e.what()};
-    }
-    return {};
-}
+std::unique_ptr<Source> started(const std::string &yaml) { return binocle::test::startSource(record(), yaml); }
 
 fake::Camera grey(const std::string &path, int seed, uint32_t w = 64, uint32_t h = 48) {
     return fake::camera(path, {fake::offer(V4L2_PIX_FMT_GREY, {{w, h}})}, seed);
@@ -75,23 +45,6 @@ fake::Camera grey(const std::string &path, int seed, uint32_t w = 64, uint32_t h
 
 fake::Camera yuyv(const std::string &path, int seed, uint32_t w = 64, uint32_t h = 48) {
     return fake::camera(path, {fake::offer(V4L2_PIX_FMT_YUYV, {{w, h}})}, seed);
-}
-
-// Largest absolute difference of two 8-bit images of one size.
-double maxDiff(const cv::Mat &a, const cv::Mat &b) {
-    EXPECT_EQ(a.size(), b.size());
-    EXPECT_EQ(a.type(), b.type());
-    if (a.size() != b.size() || a.type() != b.type()) return 1e9;
-    double m = 0;
-    cv::minMaxLoc(cv::abs(a - b), nullptr, &m);
-    return m;
-}
-
-bool inside(const void *p, const std::vector<std::pair<const uint8_t *, size_t>> &ranges) {
-    const auto *b = static_cast<const uint8_t *>(p);
-    for (const auto &r : ranges)
-        if (b >= r.first && b < r.first + r.second) return true;
-    return false;
 }
 
 YAML::Node stats(Source &s) { return YAML::Load(s.statistics()); }
