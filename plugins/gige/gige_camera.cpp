@@ -166,6 +166,10 @@ void Camera::configure() {
         }
     }
     label_ = settings_.id + (address_ != settings_.id ? " at " + address_ : "") + " (" + settings_.role + ")";
+    // Aravis opens a camera that another controller holds read-only; every write would then
+    // time out, one after the other.
+    if (ARV_IS_GV_DEVICE(device) && !arv_gv_device_is_controller(ARV_GV_DEVICE(device)))
+        fail(BINOCLE_ERR_BUSY, "another application (or another source) controls it; close that first");
 
     // A camera left acquiring by an earlier session refuses some settings.
     arv_camera_stop_acquisition(camera_, error.out());

@@ -378,6 +378,7 @@ private:
         uint64_t images = 0, losses = 0;
         std::map<std::string, uint64_t> failures;
         std::unique_ptr<TriggerWorker> trigger; // software trigger: of the current camera
+        bool answered = false;                  // software trigger: an image came for the last one
     };
 
     static std::string sizeText(const Camera &c) {
@@ -527,6 +528,8 @@ private:
 
     void requestTrigger(Clock::time_point now) {
         for (auto &slot : slots_) {
+            dropPending(*slot, true);
+            slot->answered = false;
             slot->trigger->request();
             if (!slot->awaitingSince) slot->awaitingSince = now;
         }
@@ -540,13 +543,22 @@ private:
             if (!slot.camera) continue;
             Camera &camera = *slot.camera;
             while (ArvBuffer *buffer = camera.tryPop()) {
-                if (trigger_ == "software") slot.awaitingSince.reset();
-                else if (trigger_ == "free_run") slot.awaitingSince = now;
                 const ArvBufferStatus status = arv_buffer_get_status(buffer);
+                if (trigger_ == "software") {
+                    // Exactly one image per camera answers a trigger: anything more is stale.
+                    if (slot.answered) {
+                        camera.home()->push(buffer);
+                        if (status == ARV_BUFFER_STATUS_SUCCESS) ++unpaired_;
+                        continue;
+                    }
+                    slot.answered = true;
+                    slot.awaitingSince.reset();
+                } else if (trigger_ == "free_run") {
+                    slot.awaitingSince = now;
+                }
                 if (status != ARV_BUFFER_STATUS_SUCCESS) {
                     ++slot.failures[statusName(status)];
                     camera.home()->push(buffer);
-                    if (trigger_ == "software") triggerOutstanding_ = false;
                     continue;
                 }
                 try {
@@ -595,6 +607,7 @@ private:
     }
 
     std::unique_ptr<sdk::Frame> pair() {
+        if (trigger_ == "software") return pairTriggered();
         if (sideBySide_) {
             Slot &slot = *slots_[0];
             if (slot.pending.empty()) return nullptr;
@@ -616,9 +629,41 @@ private:
             older.pending.front().home->push(older.pending.front().buffer);
             older.pending.pop_front();
             ++unpaired_;
-            if (trigger_ == "software") triggerOutstanding_ = false;
         }
         return nullptr;
+    }
+
+    // Software trigger: the images that answer one trigger make the pair, once every camera
+    // has answered; a failed image (or time stamps too far apart) drops the others and the
+    // next call triggers again. Time stamps alone could pair images of two triggers sent
+    // within pair_tolerance_ms.
+    std::unique_ptr<sdk::Frame> pairTriggered() {
+        for (const auto &slot : slots_)
+            if (!slot->answered) return nullptr;
+        triggerOutstanding_ = false;
+        bool complete = true;
+        for (const auto &slot : slots_) complete = complete && slot->pending.size() == 1;
+        if (complete && !sideBySide_) {
+            const int64_t dt = slots_[0]->pending.front().timestamp_ns - slots_[1]->pending.front().timestamp_ns;
+            if (std::llabs(dt) > toleranceNs_) {
+                lastUnpairedDtNs_ = dt;
+                complete = false;
+            }
+        }
+        if (!complete) {
+            for (auto &slot : slots_) dropPending(*slot, true);
+            return nullptr;
+        }
+        std::vector<Pending> parts;
+        std::vector<Slot *> owners;
+        for (auto &slot : slots_) {
+            parts.push_back(std::move(slot->pending.front()));
+            slot->pending.clear();
+            owners.push_back(slot.get());
+        }
+        std::vector<Pending *> views;
+        for (auto &p : parts) views.push_back(&p);
+        return makeFrame(views, owners);
     }
 
     std::unique_ptr<sdk::Frame> makeFrame(const std::vector<Pending *> &parts, const std::vector<Slot *> &slots) {

@@ -43,6 +43,10 @@ void FakeCamera::revive() {
     if (!camera_) start();
 }
 
+void FakeCamera::setLostPacketRatio(double ratio) {
+    if (camera_) g_object_set(camera_, "gvsp-lost-ratio", ratio, nullptr);
+}
+
 ArvFakeCamera *FakeCamera::fake() const { return camera_ ? arv_gv_fake_camera_get_fake_camera(camera_) : nullptr; }
 
 void FakeCamera::setFrames(std::vector<cv::Mat> frames) {

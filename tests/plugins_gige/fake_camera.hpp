@@ -29,6 +29,8 @@ public:
     void kill();
     // The same camera answers again, freshly powered (no controller, default settings).
     void revive();
+    // Share of GVSP packets the camera drops on purpose (0..1), as a bad link would.
+    void setLostPacketRatio(double ratio);
     bool alive() const { return camera_ != nullptr; }
     ArvFakeCamera *fake() const;
     int imagesSent() const;

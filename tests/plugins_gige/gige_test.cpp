@@ -270,6 +270,61 @@ TEST(Gige, SideBySideCameraGivesBothHalvesWithoutCopy) {
     EXPECT_EQ(static_cast<uint8_t *>(f->raw().right.data) - static_cast<uint8_t *>(f->raw().left.data), 320);
 }
 
+TEST(Gige, LostPacketsAreCountedAndIncompleteImagesNeverDelivered) {
+    const auto pairs = texturePairs(3);
+    FakeCamera left(kLeftAddress, "LEFT0001", lefts(pairs)), right(kRightAddress, "RIGHT001", rights(pairs));
+    left.setLostPacketRatio(0.01); // about 40 % of the 56-packet images lose one
+    right.setLostPacketRatio(0.01);
+    auto src = openGige("{" + kTwoCameras + ", trigger: software}");
+    src->start();
+    for (int k = 0; k < 10; ++k) {
+        auto f = src->grab(5000);
+        ASSERT_TRUE(f);
+        const int i = indexOf(f->left(), lefts(pairs));
+        EXPECT_GE(i, 0) << "frame " << k << ": a damaged left image was delivered";
+        EXPECT_EQ(indexOf(f->right(), rights(pairs)), i) << "frame " << k << ": a damaged or mismatched right image";
+    }
+    const YAML::Node st = statisticsOf(*src);
+    int failed = 0, missing = 0;
+    for (int c = 0; c < 2; ++c) {
+        failed += st["cameras"][c]["failed_buffers"].as<int>();
+        missing += st["cameras"][c]["missing_packets"].as<int>();
+    }
+    EXPECT_GT(failed, 0);
+    EXPECT_GT(missing, 0);
+    std::cout << "[ figures  ] 1 % GVSP packets lost: 10 good pairs; " << failed << " failed buffers, " << missing
+              << " missing packets, " << st["unpaired"].as<int>() << " unpaired images; right: "
+              << st["cameras"][1]["failed_by_status"] << "\n";
+}
+
+TEST(Gige, HardwareTriggerWaitsWithoutDeclaringTheCamerasLost) {
+    FakeCamera left(kLeftAddress, "LEFT0001"), right(kRightAddress, "RIGHT001");
+    auto src = openGige("{" + kTwoCameras + ", trigger: hardware, trigger_line: Line0, lost_after_ms: 100}");
+    src->start();
+    for (int k = 0; k < 3; ++k) {
+        const auto t0 = Clock::now();
+        auto [message, code] = errorOf([&] { src->grab(200); });
+        EXPECT_EQ(code, BINOCLE_ERR_TIMEOUT) << message; // silence is normal between hardware triggers
+        EXPECT_NE(message.find("waiting for hardware triggers on Line0"), std::string::npos) << message;
+        EXPECT_LT(msSince(t0), 200 + 300);
+    }
+    EXPECT_TRUE(statisticsOf(*src)["cameras"][0]["connected"].as<bool>());
+    // The cameras are taken: a second source is refused at once.
+    const auto t0 = Clock::now();
+    auto [busy, busyCode] = errorOf([&] { openGige("{" + kTwoCameras + "}"); });
+    EXPECT_EQ(busyCode, BINOCLE_ERR_BUSY) << busy;
+    EXPECT_NE(busy.find("camera 127.0.0.2 (left): another application (or another source) controls it"), std::string::npos) << busy;
+    const double busyMs = msSince(t0);
+    EXPECT_LT(busyMs, 10000) << "Aravis tries to take control for a while, but not for ever";
+    std::cout << "[ figures  ] a camera held by another source is refused after " << busyMs << " ms\n";
+    src.reset();
+    // A line the camera does not have is named.
+    auto [message, code] = errorOf([&] { openGige("{" + kTwoCameras + ", trigger: hardware, trigger_line: Line7}"); });
+    EXPECT_NE(message.find("camera 127.0.0.2 (left): trigger_line = Line7 not offered (the camera offers: Line0, Software)"),
+              std::string::npos)
+        << message;
+}
+
 TEST(Gige, FeaturesAreSetOnTheCameras) {
     FakeCamera left(kLeftAddress, "LEFT0001"), right(kRightAddress, "RIGHT001");
     auto src = openGige("{" + kTwoCameras + ", exposure_us: 2500, gain_db: 3, frame_rate_hz: 40}");
