@@ -670,6 +670,32 @@ TEST(GigeDevices, CliReportsAFailingPluginAndStillListsTheOthers) {
     EXPECT_NE(r.output.find("replay:\n  devices: []"), std::string::npos) << r.output;
 }
 
+TEST(GigeCli, RecordsTwoCamerasAndTheRecordingReplaysThem) {
+    const auto pairs = texturePairs(3);
+    FakeCamera left(kLeftAddress, "LEFT0001", lefts(pairs)), right(kRightAddress, "RIGHT001", rights(pairs));
+    binocle::test::TempDir dir;
+    binocle::test::writeText(dir.str("rig.yaml"), "name: gige-cli\nsource: {plugin: gige, " + kTwoCameras +
+                                                       ", trigger: free_run}\nmatcher: {plugin: sgbm}\n");
+    // The rig says free_run; --set switches to software triggers, as on a real rig.
+    const auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("rec") +
+                                         " --frames 5 --set source.trigger=software --statistics --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("5 frame(s) of rig 'gige-cli' recorded"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("layout: two_cameras"), std::string::npos) << r.output;
+    const auto &replay = plugin("replay");
+    Source back(replay, binocle::paramsFromYaml(replay, "{folder: " + dir.str("rec") + ", color: gray}"));
+    back.start();
+    int n = 0;
+    while (auto f = back.grab(1000)) {
+        const int i = indexOf(f->left(), lefts(pairs));
+        EXPECT_GE(i, 0) << "frame " << n;
+        EXPECT_EQ(indexOf(f->right(), rights(pairs)), i) << "frame " << n;
+        EXPECT_LE(std::llabs(f->raw().timestamp_left_ns - f->raw().timestamp_right_ns), 5000000);
+        ++n;
+    }
+    EXPECT_EQ(n, 5);
+}
+
 } // namespace
 
 // Aravis's discovery broadcasts on every interface: these tests run only where `lo` is the
