@@ -124,11 +124,9 @@ int calibrate(const Args &args) {
     std::optional<PluginHost> host;
     StatedGeometry stated;
     if (!args.positional().empty()) {
-        std::vector<Override> overrides;
-        for (const auto &s : args.all("--set")) overrides.push_back(Override::parse(s));
         host.emplace();
         host->scan();
-        rig = loadRig(args.positional()[0], overrides, *host);
+        rig = loadRigFromArgs(args, *host);
         stated = statedGeometry(rig->source);
     } else if (args.has("--set")) {
         throw Error("--set changes a rig, but no rig file was given");

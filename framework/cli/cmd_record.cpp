@@ -27,11 +27,9 @@ extern "C" void onStopSignal(int sig) {
 int run(const Args &args) {
     if (args.positional().size() != 1) throw Error("expected one rig file: binocle record RIG.yaml --out DIR (see --help)");
     if (!args.has("--out") || args.get("--out").empty()) throw Error("missing --out DIR: the folder to record into");
-    std::vector<Override> overrides;
-    for (const auto &s : args.all("--set")) overrides.push_back(Override::parse(s));
     PluginHost host;
     host.scan();
-    RigConfig rig = loadRig(args.positional()[0], overrides, host);
+    RigConfig rig = loadRigFromArgs(args, host);
     RecordOptions options;
     options.max_frames = args.integer("--frames", -1);
     if (args.has("--frames") && options.max_frames < 1)

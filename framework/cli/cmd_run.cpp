@@ -12,11 +12,9 @@ namespace {
 
 int run(const Args &args) {
     if (args.positional().size() != 1) throw Error("expected one rig file: binocle run RIG.yaml (see --help)");
-    std::vector<Override> overrides;
-    for (const auto &s : args.all("--set")) overrides.push_back(Override::parse(s));
     PluginHost host;
     host.scan();
-    RigConfig rig = loadRig(args.positional()[0], overrides, host);
+    RigConfig rig = loadRigFromArgs(args, host);
     RunOptions options;
     options.max_frames = args.integer("--frames", -1);
     options.out_dir = args.get("--out", "");

@@ -2,6 +2,8 @@
 // The `binocle` command: subcommands register themselves, one file each (cmd_*.cpp).
 #pragma once
 
+#include "config/rig_config.hpp"
+
 #include <functional>
 #include <map>
 #include <string>
@@ -36,6 +38,10 @@ struct Command {
 };
 
 const std::map<std::string, Command> &commands();
+
+// The rig named by the first positional argument, with every --set override applied,
+// validated against the plugins `host` found.
+RigConfig loadRigFromArgs(const Args &args, const PluginHost &host);
 
 // A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
 // next to the executable, else from the source tree it was built from.

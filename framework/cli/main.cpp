@@ -20,6 +20,12 @@ std::map<std::string, Command> &registry() {
 
 const std::map<std::string, Command> &commands() { return registry(); }
 
+RigConfig loadRigFromArgs(const Args &args, const PluginHost &host) {
+    std::vector<Override> overrides;
+    for (const auto &s : args.all("--set")) overrides.push_back(Override::parse(s));
+    return loadRig(args.positional().at(0), overrides, host);
+}
+
 std::string dataFile(const std::string &relative) {
     std::error_code ec;
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
