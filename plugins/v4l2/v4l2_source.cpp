@@ -411,6 +411,7 @@ void V4l2Source::start() {
         Stream &st = *sp;
         std::lock_guard<std::mutex> lock(st.mutex);
         if (!st.gone.empty()) throw Error(BINOCLE_ERR_DEVICE, st.gone);
+        if (st.streaming) continue; // started by an earlier start that failed on the other device
         Device &d = st.device();
         try {
             if (st.buffers.empty()) {

@@ -467,6 +467,21 @@ TEST_F(V4l2, AFrameLentAcrossStopAndStartIsQueuedWhenItComesBack) {
     EXPECT_EQ(c.opened, c.closed);
 }
 
+TEST_F(V4l2, AStartThatFailsOnOneDeviceCanBeRetried) {
+    addGreyPair();
+    auto src = make(kGrey);
+    fakes().change("/dev/video1", [](fake::Camera &c) { c.busy = true; }); // taken meanwhile
+    const Failure busy = failureOf([&] { src->start(); });
+    EXPECT_EQ(busy.code, BINOCLE_ERR_BUSY) << busy.message;
+    EXPECT_NE(busy.message.find("/dev/video1 is busy (EBUSY in VIDIOC_REQBUFS)"), std::string::npos) << busy.message;
+    fakes().change("/dev/video1", [](fake::Camera &c) { c.busy = false; });
+    src->start();
+    auto f = src->grab(1000);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(maxDiff(f->left(), fake::pattern(64, 48, 0, 1)), 0);
+    EXPECT_EQ(maxDiff(f->right(), fake::pattern(64, 48, 0, 2)), 0);
+}
+
 TEST_F(V4l2, GrabBeforeStartIsRefused) {
     addGreyPair();
     auto src = make(kGrey);
