@@ -24,15 +24,18 @@ public:
 
     // Standard normal drawn from a fixed table of 65536 Box-Muller values: one engine
     // call per value, for sensor noise on every pixel.
-    float tableNormal() {
+    float tableNormal() { return normalTable()[engine_() & 0xFFFFu]; }
+    static const float *normalTable() {
         static const std::vector<float> table = [] {
             Random r(0x5eed);
             std::vector<float> t(65536);
             for (float &v : t) v = static_cast<float>(r.normal());
             return t;
         }();
-        return table[engine_() & 0xFFFFu];
+        return table.data();
     }
+    // The engine's next 32 bits.
+    uint32_t bits() { return static_cast<uint32_t>(engine_()); }
 
     // Standard normal (Box-Muller; the second value of each pair is kept for the next call).
     double normal() {

@@ -6,6 +6,7 @@
 #include "random.hpp"
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -18,15 +19,24 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kEpsilon = 1e-6; // mm: hits closer than this to the origin are ignored
 
-// Slab test against axis-aligned bounds; true when the ray enters them before tMax.
-inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3 &hi, double tMax) {
+// Slab test against axis-aligned bounds lo..hi; true when the ray enters them before tMax,
+// `entry` the distance where it does (0 when it starts inside). Written out per axis: the
+// hottest few lines of the renderer.
+inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3 &hi, double tMax, double &entry) {
+    // NaN (0 * inf, a ray in a slab's plane) loses every comparison: it leaves tn / tf as they are.
+    const double x1 = (lo.x() - o.x()) * inv.x(), x2 = (hi.x() - o.x()) * inv.x();
+    const double y1 = (lo.y() - o.y()) * inv.y(), y2 = (hi.y() - o.y()) * inv.y();
+    const double z1 = (lo.z() - o.z()) * inv.z(), z2 = (hi.z() - o.z()) * inv.z();
     double tn = 0, tf = tMax;
-    for (int a = 0; a < 3; ++a) {
-        double t1 = (lo[a] - o[a]) * inv[a], t2 = (hi[a] - o[a]) * inv[a];
-        if (t1 > t2) std::swap(t1, t2);
-        tn = std::max(tn, t1); // NaN (0 * inf) leaves tn / tf unchanged
-        tf = std::min(tf, t2);
-    }
+    auto grow = [&](double a, double b) {
+        const double near = a < b ? a : b, far = a < b ? b : a;
+        if (near > tn) tn = near;
+        if (far < tf) tf = far;
+    };
+    grow(x1, x2);
+    grow(y1, y2);
+    grow(z1, z2);
+    entry = tn;
     return tn <= tf;
 }
 
@@ -56,11 +66,20 @@ inline bool hitBox(const Vec3 &o, const Vec3 &d, const Vec3 &inv, const Vec3 &h,
 }
 
 inline bool hitEllipsoid(const Primitive &p, const Vec3 &o, const Vec3 &d, double tMax, double &t) {
-    const Vec3 q = (o - p.center).cwiseQuotient(p.half), e = d.cwiseQuotient(p.half);
-    const double a = e.squaredNorm(), b = q.dot(e), c = q.squaredNorm() - 1.0;
-    const double disc = b * b - a * c;
-    if (disc < 0) return false;
-    const double tt = (-b - std::sqrt(disc)) / a;
+    double tt;
+    if (p.half.x() == p.half.y() && p.half.x() == p.half.z()) { // sphere: no division
+        const Vec3 oc = o - p.center;
+        const double b = oc.dot(d), c = oc.squaredNorm() - p.half.x() * p.half.x();
+        const double disc = b * b - c;
+        if (disc < 0) return false;
+        tt = -b - std::sqrt(disc);
+    } else {
+        const Vec3 q = (o - p.center).cwiseQuotient(p.half), e = d.cwiseQuotient(p.half);
+        const double a = e.squaredNorm(), b = q.dot(e), c = q.squaredNorm() - 1.0;
+        const double disc = b * b - a * c;
+        if (disc < 0) return false;
+        tt = (-b - std::sqrt(disc)) / a;
+    }
     if (tt <= kEpsilon || tt >= tMax) return false;
     t = tt;
     return true;
@@ -106,6 +125,8 @@ inline Vec3 boxAxis(int face) {
 
 inline double clamp01(double v) { return v < 0 ? 0 : (v > 1 ? 1 : v); }
 
+inline Vec3 unit(const Vec3 &v) { return v * (1.0 / v.norm()); } // one division, not three
+
 // Surface coordinates (u, v) of point p on a face of a box: right and up as seen from
 // outside the face, origin at its corner.
 inline void boxFaceUv(const Primitive &prim, int face, const Vec3 &p, double &u, double &v) {
@@ -122,12 +143,10 @@ inline void boxFaceUv(const Primitive &prim, int face, const Vec3 &p, double &u,
 }
 
 // Where the ray origin + s * dir meets the plane through p with normal n (tangent plane);
-// far away when it runs parallel to it or away from it.
-inline Vec3 onTangentPlane(const Vec3 &o, const Vec3 &dir, const Vec3 &p, const Vec3 &n) {
-    const double den = n.dot(dir), num = n.dot(p - o);
-    const double s = num / den;
-    if (!(s > 0) || !std::isfinite(s)) return p + 1e6 * dir.normalized();
-    return o + s * dir;
+// far away when it runs parallel to it or away from it. nDistance = n . (p - origin).
+inline Vec3 onTangentPlane(const Vec3 &o, const Vec3 &dir, const Vec3 &n, double nDistance) {
+    const double s = nDistance / n.dot(dir);
+    return o + (s > 0 && s < 1e12 ? s : 1e12) * dir;
 }
 
 // One pixel's worth of ground truth from the ray through its centre.
@@ -165,6 +184,89 @@ TruthRow truthRow(RenderedFrame &out, int v) {
 
 } // namespace
 
+Tracer::Tracer(const Scene &scene) : scene_(scene) {
+    order_.resize(scene.primitives.size());
+    for (size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<int>(i);
+    if (order_.empty()) return;
+    build(0, static_cast<int>(order_.size()));
+    rootCentre_ = (nodes_[0].lo + nodes_[0].hi) / 2;
+    rootRadius2_ = (nodes_[0].hi - nodes_[0].lo).squaredNorm() / 4 * (1 + 1e-9);
+}
+
+// Median split along the longest axis of the primitives' centres; leaves of up to two.
+// Splits where the surface area heuristic is lowest (each axis, primitives sorted by
+// centre); leaves of up to two primitives.
+int Tracer::build(int begin, int end) {
+    const int index = static_cast<int>(nodes_.size());
+    nodes_.emplace_back();
+    auto boundsOf = [&](int k, Vec3 &lo, Vec3 &hi) {
+        const Primitive &p = scene_.primitives[static_cast<size_t>(order_[static_cast<size_t>(k)])];
+        lo = lo.cwiseMin(primitiveMin(p));
+        hi = hi.cwiseMax(primitiveMax(p));
+    };
+    Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
+    for (int k = begin; k < end; ++k) boundsOf(k, lo, hi);
+    nodes_[static_cast<size_t>(index)].lo = lo;
+    nodes_[static_cast<size_t>(index)].hi = hi;
+    const int n = end - begin;
+    if (n <= 2) {
+        nodes_[static_cast<size_t>(index)].first = begin;
+        nodes_[static_cast<size_t>(index)].count = n;
+        return index;
+    }
+    auto area = [](const Vec3 &a, const Vec3 &b) {
+        const Vec3 e = (b - a).cwiseMax(0.0);
+        return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    double bestCost = kInf;
+    int bestAxis = 0, bestSplit = begin + n / 2;
+    std::vector<double> leftArea(static_cast<size_t>(n));
+    for (int axis = 0; axis < 3; ++axis) {
+        std::sort(order_.begin() + begin, order_.begin() + end, [&](int a, int b) {
+            return scene_.primitives[static_cast<size_t>(a)].center[axis] < scene_.primitives[static_cast<size_t>(b)].center[axis];
+        });
+        Vec3 l = Vec3::Constant(kInf), h = Vec3::Constant(-kInf);
+        for (int k = 0; k < n; ++k) {
+            boundsOf(begin + k, l, h);
+            leftArea[static_cast<size_t>(k)] = area(l, h); // of the first k + 1
+        }
+        l = Vec3::Constant(kInf);
+        h = Vec3::Constant(-kInf);
+        for (int k = n - 1; k >= 1; --k) {
+            boundsOf(begin + k, l, h); // right part: k .. n - 1
+            const double cost = leftArea[static_cast<size_t>(k - 1)] * k + area(l, h) * (n - k);
+            if (cost < bestCost) {
+                bestCost = cost;
+                bestAxis = axis;
+                bestSplit = begin + k;
+            }
+        }
+    }
+    std::sort(order_.begin() + begin, order_.begin() + end, [&](int a, int b) {
+        return scene_.primitives[static_cast<size_t>(a)].center[bestAxis] < scene_.primitives[static_cast<size_t>(b)].center[bestAxis];
+    });
+    build(begin, bestSplit);
+    const int second = build(bestSplit, end);
+    nodes_[static_cast<size_t>(index)].first = second;
+    nodes_[static_cast<size_t>(index)].axis = bestAxis;
+    return index;
+}
+
+bool Tracer::hitPrimitive(int i, const Vec3 &o, const Vec3 &d, const Vec3 &inv, double best, double &t, int &face) const {
+    const Primitive &p = scene_.primitives[static_cast<size_t>(i)];
+    switch (p.shape) {
+    case Shape::Box:
+        if (p.axisAligned) return hitBox(o - p.center, d, inv, p.half, best, t, face);
+        {
+            const Vec3 dl = p.rotation.transpose() * d;
+            return hitBox(p.rotation.transpose() * (o - p.center), dl, dl.cwiseInverse(), p.half, best, t, face);
+        }
+    case Shape::Ellipsoid: face = 0; return hitEllipsoid(p, o, d, best, t);
+    case Shape::Cylinder: return hitCylinder(p, o, d, best, t, face);
+    }
+    return false;
+}
+
 bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
     double best = kInf;
     bool found = false;
@@ -174,36 +276,65 @@ bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
         hit.face = 4;
         found = true;
     }
+    if (nodes_.empty()) {
+        hit.t = best;
+        return found;
+    }
+    // Bounding sphere of everything first: most rays (sky, near ground) end here, before
+    // the divisions of the slab tests.
+    const Vec3 oc = rootCentre_ - o;
+    const double b = oc.dot(d), c2 = oc.squaredNorm() - b * b;
+    if (c2 > rootRadius2_) {
+        hit.t = best;
+        return found;
+    }
+    const double half = std::sqrt(rootRadius2_ - c2);
+    if (b + half < 0 || b - half > best) {
+        hit.t = best;
+        return found;
+    }
     const Vec3 inv = d.cwiseInverse();
-    for (const SceneObject &obj : scene_.objects) {
-        if (!hitBounds(o, inv, obj.boundsMin, obj.boundsMax, best)) continue;
-        for (int i = obj.firstPrimitive; i < obj.firstPrimitive + obj.primitiveCount; ++i) {
-            const Primitive &p = scene_.primitives[static_cast<size_t>(i)];
-            double t = 0;
-            int face = 0;
-            bool h = false;
-            switch (p.shape) {
-            case Shape::Box:
-                if (p.axisAligned) {
-                    h = hitBox(o - p.center, d, inv, p.half, best, t, face);
-                } else {
-                    const Vec3 dl = p.rotation.transpose() * d;
-                    h = hitBox(p.rotation.transpose() * (o - p.center), dl, dl.cwiseInverse(), p.half, best, t, face);
+    int stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const int index = stack[--top];
+        const Node &node = nodes_[static_cast<size_t>(index)];
+        double entry = 0;
+        if (!hitBounds(o, inv, node.lo, node.hi, best, entry)) continue;
+        if (node.count > 0) {
+            for (int k = node.first; k < node.first + node.count; ++k) {
+                const int i = order_[static_cast<size_t>(k)];
+                double t = 0;
+                int face = 0;
+                if (hitPrimitive(i, o, d, inv, best, t, face)) {
+                    best = t;
+                    hit.primitive = i;
+                    hit.face = face;
+                    found = true;
                 }
-                break;
-            case Shape::Ellipsoid: h = hitEllipsoid(p, o, d, best, t); break;
-            case Shape::Cylinder: h = hitCylinder(p, o, d, best, t, face); break;
             }
-            if (h) {
-                best = t;
-                hit.primitive = i;
-                hit.face = face;
-                found = true;
-            }
+            continue;
+        }
+        // Visit first (stack last) the child on the side the ray comes from along the
+        // split axis: its hits prune the other's bounds.
+        const int first = index + 1, second = node.first;
+        if (d[node.axis] > 0) {
+            stack[top++] = second;
+            stack[top++] = first;
+        } else {
+            stack[top++] = first;
+            stack[top++] = second;
         }
     }
     hit.t = best;
     return found;
+}
+
+float Tracer::edgeId(const Hit &hit) const {
+    if (hit.primitive < 0) return 12.0f;
+    const Primitive &p = scene_.primitives[static_cast<size_t>(hit.primitive)];
+    return static_cast<float>((p.object + 2) * 8 + (p.shape == Shape::Ellipsoid ? 0 : hit.face));
 }
 
 uint16_t Tracer::objectId(const Hit &hit) const {
@@ -239,7 +370,8 @@ Rgb Tracer::shade(const Vec3 &o, const Vec3 &d, const Hit &hit, const Vec3 &dir,
         }
     }
     // Ray differentials: where the footprint's edges meet the tangent plane.
-    const Vec3 px = onTangentPlane(o, dir + dirDx, p, n), py = onTangentPlane(o, dir + dirDy, p, n);
+    const double nDistance = hit.t * n.dot(d);
+    const Vec3 px = onTangentPlane(o, dir + dirDx, n, nDistance), py = onTangentPlane(o, dir + dirDy, n, nDistance);
     if (!prim || prim->shape == Shape::Box) {
         double u0, v0, ux, vx, uy, vy;
         if (!prim) {
@@ -275,47 +407,48 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
     // Change of the (unnormalised) ray direction from one pixel to the next.
     const Vec3 stepX = cam.rotation.col(0) / cam.fx, stepY = cam.rotation.col(1) / cam.fy;
     cv::Mat out(cam.height, cam.width, CV_32FC3);
-    cv::Mat surface(cam.height, cam.width, CV_32S); // what the centre ray hit: primitive and face
+    // What each centre ray met, for finding edges: (object + 2) * 8 + face (faces of boxes
+    // and cylinders only), 12 the ground, 0 the sky.
+    cv::Mat surface(cam.height, cam.width, CV_32F);
     if (truth) allocateTruth(*truth, cam.width, cam.height);
 
     // Pass 1: one ray through each pixel centre, texture filtered over the whole pixel.
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
         for (int v = rows.start; v < rows.end; ++v) {
             cv::Vec3f *row = out.ptr<cv::Vec3f>(v);
-            int32_t *ids = surface.ptr<int32_t>(v);
+            float *ids = surface.ptr<float>(v);
             TruthRow gt{};
             if (truth) gt = truthRow(*truth, v);
+            const Vec3 rowStart = cam.direction(0, v);
             for (int u = 0; u < cam.width; ++u) {
-                const Vec3 dir = cam.direction(u, v), d = dir.normalized();
+                // Undistorted imagers: the direction grows by stepX from pixel to pixel.
+                const Vec3 dir = cam.distorted ? cam.direction(u, v) : Vec3(rowStart + u * stepX), d = unit(dir);
                 Tracer::Hit hit;
                 const bool found = tracer.trace(cam.center, d, hit);
                 const Rgb c = found ? tracer.shade(cam.center, d, hit, dir, stepX, stepY) : tracer.sky(d);
                 row[u] = cv::Vec3f(c.x(), c.y(), c.z());
-                ids[u] = found ? (hit.primitive + 2) * 8 + hit.face : 0;
+                ids[u] = found ? tracer.edgeId(hit) : 0.0f;
                 if (truth) gt.set(u, rig_, tracer, found, hit, d.dot(axis));
             }
         }
     });
     if (n == 1) return out;
 
-    // Pass 2: pixels that straddle an edge (a neighbour's centre ray met another surface
-    // or face) are supersampled n x n.
+    // Pass 2: pixels that straddle an edge (a centre ray of their 3 x 3 neighbourhood met
+    // another object or face: the neighbourhood's max and min differ) are supersampled.
+    // Creases between the spheres of a crown are not edges: the shading is continuous
+    // enough there.
+    cv::Mat highest, lowest;
+    cv::dilate(surface, highest, cv::Mat());
+    cv::erode(surface, lowest, cv::Mat());
+    const cv::Mat edges = highest != lowest;
     const Vec3 subX = stepX / n, subY = stepY / n;
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
         for (int v = rows.start; v < rows.end; ++v) {
             cv::Vec3f *row = out.ptr<cv::Vec3f>(v);
-            const int32_t *ids = surface.ptr<int32_t>(v);
+            const uint8_t *edge = edges.ptr<uint8_t>(v);
             for (int u = 0; u < cam.width; ++u) {
-                bool edge = false;
-                for (int y = std::max(0, v - 1); y <= std::min(cam.height - 1, v + 1) && !edge; ++y) {
-                    const int32_t *r = surface.ptr<int32_t>(y);
-                    for (int x = std::max(0, u - 1); x <= std::min(cam.width - 1, u + 1); ++x)
-                        if (r[x] != ids[u]) {
-                            edge = true;
-                            break;
-                        }
-                }
-                if (!edge) continue;
+                if (!edge[u]) continue;
                 Rgb sum = Rgb::Zero();
                 for (int j = 0; j < n; ++j) {
                     for (int i = 0; i < n; ++i) {
@@ -323,7 +456,7 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
                         // samples take n^2 distinct columns and rows ("n-rooks"): edges
                         // along the image axes are resolved to 1/n^2 of a pixel, not 1/n.
                         const double x = (i + (j + 0.5) / n) / n, y = (j + (i + 0.5) / n) / n;
-                        const Vec3 dir = cam.direction(u - 0.5 + x, v - 0.5 + y), d = dir.normalized();
+                        const Vec3 dir = cam.direction(u - 0.5 + x, v - 0.5 + y), d = unit(dir);
                         Tracer::Hit hit;
                         sum += tracer.trace(cam.center, d, hit) ? tracer.shade(cam.center, d, hit, dir, subX, subY)
                                                                  : tracer.sky(d);
@@ -339,25 +472,35 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
 
 cv::Mat Renderer::expose(const cv::Mat &radiance, int imager, uint64_t frame) const {
     const bool right = imager == 1;
-    const double gain = 255.0 * (right ? settings_.gain_right : 1.0);
-    const double offset = right ? settings_.offset_right : 0.0;
-    const double sigma = settings_.noise_sigma / std::max(1, settings_.binning);
+    const float gain = static_cast<float>(255.0 * (right ? settings_.gain_right : 1.0));
+    const float offset = static_cast<float>(right ? settings_.offset_right : 0.0) + 0.5f; // + 0.5: rounding
+    const float sigma = static_cast<float>(settings_.noise_sigma / std::max(1, settings_.binning));
+    const float *normal = Random::normalTable();
+    auto quantise = [](float v) { return v <= 0.0f ? uint8_t{0} : (v >= 255.0f ? uint8_t{255} : static_cast<uint8_t>(v)); };
     cv::Mat out(radiance.size(), settings_.color ? CV_8UC3 : CV_8UC1);
     cv::parallel_for_(cv::Range(0, radiance.rows), [&](const cv::Range &rows) {
         for (int v = rows.start; v < rows.end; ++v) {
             // One generator per row: the same bytes whatever the number of threads.
             Random rng({settings_.seed, static_cast<uint32_t>(frame), static_cast<uint32_t>(frame >> 32),
                         static_cast<uint32_t>(imager), static_cast<uint32_t>(v)});
-            auto noise = [&] { return sigma > 0 ? sigma * rng.tableNormal() : 0.0; };
+            // Two table indices per engine draw.
+            uint32_t bits = 0;
+            bool spare = false;
+            auto noise = [&] {
+                if (sigma <= 0) return 0.0f;
+                if (!spare) bits = rng.bits();
+                spare = !spare;
+                return sigma * normal[spare ? (bits & 0xFFFFu) : (bits >> 16)];
+            };
             const cv::Vec3f *in = radiance.ptr<cv::Vec3f>(v);
             uint8_t *dst = out.ptr<uint8_t>(v);
             for (int u = 0; u < radiance.cols; ++u) {
                 const cv::Vec3f &c = in[u]; // R, G, B
                 if (!settings_.color) {
-                    const double grey = 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2];
-                    dst[u] = cv::saturate_cast<uint8_t>(grey * gain + offset + noise());
+                    const float grey = 0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2];
+                    dst[u] = quantise(grey * gain + offset + noise());
                 } else {
-                    for (int k = 0; k < 3; ++k) dst[3 * u + k] = cv::saturate_cast<uint8_t>(c[2 - k] * gain + offset + noise());
+                    for (int k = 0; k < 3; ++k) dst[3 * u + k] = quantise(c[2 - k] * gain + offset + noise()); // BGR
                 }
             }
         }

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <vector>
 
 namespace binocle::sim {
 
@@ -40,7 +41,7 @@ public:
         int face = 0;        // box face +X, -X, +Y, -Y, +Z, -Z; cylinder 0 side, 4 top, 5 bottom
     };
 
-    explicit Tracer(const Scene &scene) : scene_(scene) {}
+    explicit Tracer(const Scene &scene); // builds a bounding volume hierarchy of the primitives
     // Nearest surface along origin + t * direction (direction of unit length).
     bool trace(const Vec3 &origin, const Vec3 &direction, Hit &hit) const;
     // Light leaving the surface of `hit` towards the origin. dir: the ray's direction
@@ -50,9 +51,24 @@ public:
               const Vec3 &dirDy) const;
     Rgb sky(const Vec3 &unitDir) const;
     uint16_t objectId(const Hit &hit) const;
+    // What an edge separates: the object and, for boxes and cylinders, the face.
+    float edgeId(const Hit &hit) const;
 
 private:
+    struct Node {
+        Vec3 lo, hi;      // bounds of everything below
+        int first = 0;    // leaf: first index in order_; inner: index of the second child
+        int count = 0;    // leaf: number of primitives; inner: 0 (first child follows the node)
+        int axis = 0;     // inner: the split axis, to visit the nearer child first
+    };
+    int build(int begin, int end);
+    bool hitPrimitive(int index, const Vec3 &o, const Vec3 &d, const Vec3 &inv, double best, double &t, int &face) const;
+
     const Scene &scene_;
+    std::vector<Node> nodes_;
+    std::vector<int> order_; // primitive indices, leaves' ranges
+    Vec3 rootCentre_{0, 0, 0}; // bounding sphere of the root's bounds
+    double rootRadius2_ = 0;
 };
 
 class Renderer {

@@ -68,8 +68,8 @@ Vec2 Camera::undistort(const Vec2 &target) const {
 }
 
 Vec3 Camera::direction(double u, double v) const {
-    Vec2 n((u - cx) / fx, (v - cy) / fy);
-    if (distorted) n = undistort(n);
+    if (!distorted) return rotation.col(2) + rotation.col(0) * ((u - cx) / fx) + rotation.col(1) * ((v - cy) / fy);
+    const Vec2 n = undistort(Vec2((u - cx) / fx, (v - cy) / fy));
     return rotation * Vec3(n.x(), n.y(), 1.0);
 }
 

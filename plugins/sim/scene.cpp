@@ -152,24 +152,6 @@ private:
     std::string origin_, baseDir_;
 };
 
-Vec3 primitiveMin(const Primitive &p) {
-    switch (p.shape) {
-    case Shape::Box: return p.center - p.rotation.cwiseAbs() * p.half;
-    case Shape::Ellipsoid: return p.center - p.half;
-    case Shape::Cylinder: return p.center - Vec3(p.half.x(), p.half.x(), 0);
-    }
-    return p.center;
-}
-
-Vec3 primitiveMax(const Primitive &p) {
-    switch (p.shape) {
-    case Shape::Box: return p.center + p.rotation.cwiseAbs() * p.half;
-    case Shape::Ellipsoid: return p.center + p.half;
-    case Shape::Cylinder: return p.center + Vec3(p.half.x(), p.half.x(), p.half.z());
-    }
-    return p.center;
-}
-
 class SceneBuilder {
 public:
     SceneBuilder(Scene &scene, const Reader &reader) : scene_(scene), r_(reader) {}
@@ -399,14 +381,16 @@ private:
         prims.push_back(core);
         Random rng(seed);
         for (int i = 0; i < spheres; ++i) {
+            // Clumps on the core's surface, bulging out of it up to the crown's ellipsoid
+            // (a sphere hidden inside the core would cost rays and show nothing).
             Vec3 d;
             do d = Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
-            while (d.squaredNorm() > 1);
+            while (d.squaredNorm() > 1 || d.squaredNorm() < 1e-4);
+            d.normalize();
             const double r = rng.uniform(sr[0], sr[1]);
             Primitive s = core;
             s.half = Vec3::Constant(r);
-            // Keep each sphere inside the crown's ellipsoid.
-            s.center = crownCenter + d.cwiseProduct((radii - s.half).cwiseMax(0.0));
+            s.center = crownCenter + d.cwiseProduct((radii - s.half).cwiseMax(0.0)) * rng.uniform(0.8, 1.0);
             prims.push_back(s);
         }
         Vec3 lo = primitiveMin(prims[1]), hi = primitiveMax(prims[1]);
@@ -424,6 +408,24 @@ private:
 };
 
 } // namespace
+
+Vec3 primitiveMin(const Primitive &p) {
+    switch (p.shape) {
+    case Shape::Box: return p.center - p.rotation.cwiseAbs() * p.half;
+    case Shape::Ellipsoid: return p.center - p.half;
+    case Shape::Cylinder: return p.center - Vec3(p.half.x(), p.half.x(), 0);
+    }
+    return p.center;
+}
+
+Vec3 primitiveMax(const Primitive &p) {
+    switch (p.shape) {
+    case Shape::Box: return p.center + p.rotation.cwiseAbs() * p.half;
+    case Shape::Ellipsoid: return p.center + p.half;
+    case Shape::Cylinder: return p.center + Vec3(p.half.x(), p.half.x(), p.half.z());
+    }
+    return p.center;
+}
 
 Scene Scene::fromYaml(const std::string &text, const std::string &origin, const std::string &baseDir) {
     Reader reader(origin, baseDir);

@@ -33,6 +33,10 @@ struct Primitive {
     int object = 0;            // index in Scene::objects
 };
 
+// Axis-aligned bounds of a primitive in the ground frame.
+Vec3 primitiveMin(const Primitive &p);
+Vec3 primitiveMax(const Primitive &p);
+
 // A named part whose truth goes into the metadata (a cube of the panel, a trunk ...).
 struct Part {
     std::string name;

@@ -38,7 +38,13 @@ inline double latticeValue(int32_t x, int32_t y, uint32_t seed) {
 inline double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 inline double lerp(double a, double b, double t) { return a + (b - a) * t; }
 inline double clamp01(double v) { return v < 0 ? 0 : (v > 1 ? 1 : v); }
-inline int wrapIndex(long i, int n) { return static_cast<int>(((i % n) + n) % n); }
+
+// floor() without a libm call (the baseline x86-64 target has no rounding instruction).
+inline double fastFloor(double v) {
+    if (!(std::abs(v) < 9e15)) return std::floor(v);
+    const double t = static_cast<double>(static_cast<long long>(v));
+    return t > v ? t - 1.0 : t;
+}
 
 // log2 within 0.01, continuous (it picks and blends ripmap levels), for x >= 1.
 inline double fastLog2(double x) {
@@ -55,32 +61,39 @@ inline double fastLog2(double x) {
 
 Rgb mix(const Rgb &a, const Rgb &b, double t) { return a + (b - a) * static_cast<float>(t); }
 
-// Noise texture value (about [-1, 1]) at (u, v) mm with footprint edges (a, b) mm.
-inline double noiseAt(const Texture &t, double u, double v, double au, double av, double bu, double bv) {
+// Noise texture value (about [-1, 1]) at (u, v) mm, box-filtered over wu by wv mm.
+// Averaged over more than one tile, a tile keeps its column (row) means, where an endless
+// texture would average out like 1 / sqrt(length): the excess is taken away, or the
+// ground near the horizon would show the tile's columns as streaks.
+inline double noiseAt(const Texture &t, double u, double v, double wu, double wv) {
     float n = 0;
-    t.raster->sample(u / t.texel_mm[0], v / t.texel_mm[1], (std::abs(au) + std::abs(bu)) / t.texel_mm[0],
-                     (std::abs(av) + std::abs(bv)) / t.texel_mm[1], &n);
-    return n;
+    t.raster->sample(u / t.texel_mm[0], v / t.texel_mm[1], wu / t.texel_mm[0], wv / t.texel_mm[1], &n);
+    const double period = t.raster->width() * t.texel_mm[0];
+    double gain = 1;
+    if (wu > period) gain *= std::sqrt(period / wu);
+    if (wv > period) gain *= std::sqrt(period / wv);
+    return gain * n;
 }
 
-// Planar noise: two copies of the tile, the second rotated and scaled by incommensurate
-// amounts, so that the sum never repeats (a matcher must not find the tile's period).
+// Planar noise: the tile read through a slow, smooth warp of its coordinates (waves
+// whose periods are incommensurate with the tile's): between one period and the next the
+// lookup drifts by more than a feature, so the texture never repeats and a matcher finds
+// no period. The warp stretches the pattern by at most 10 %, which the footprint ignores.
 double planarNoise(const Texture &t, const SurfacePoint &sp) {
-    constexpr double c = 0.8253356149 * 0.73, s = 0.5646424734 * 0.73; // 0.6 rad, x 0.73
-    auto rot = [&](double u, double v, double &ru, double &rv) {
-        ru = c * u - s * v;
-        rv = s * u + c * v;
+    const double period = t.raster->width() * t.texel_mm[0];
+    // A periodic wave in [-0.5, 0.5] with continuous slope (two smoothsteps), slope <= 3.
+    auto wave = [](double q) {
+        double f = q - fastFloor(q);
+        f = f < 0.5 ? 2 * f : 2 - 2 * f;
+        return f * f * (3 - 2 * f) - 0.5;
     };
-    double u2, v2, au, av, bu, bv;
-    rot(sp.u, sp.v, u2, v2);
-    rot(sp.dudx, sp.dvdx, au, av);
-    rot(sp.dudy, sp.dvdy, bu, bv);
-    const double a = noiseAt(t, sp.u, sp.v, sp.dudx, sp.dvdx, sp.dudy, sp.dvdy);
-    const double b = noiseAt(t, u2 + 517.0 * t.texel_mm[0], v2 - 211.0 * t.texel_mm[1], au, av, bu, bv);
-    return (a + b) * 0.70710678118654752;
+    const double a = 0.138 * period, ku = 1.0 / (4.13 * period), kv = 1.0 / (9.71 * period);
+    const double u = sp.u + a * wave(ku * sp.u + kv * sp.v), v = sp.v + a * wave(ku * sp.v - kv * sp.u + 0.37);
+    return noiseAt(t, u, v, std::abs(sp.dudx) + std::abs(sp.dudy), std::abs(sp.dvdx) + std::abs(sp.dvdy));
 }
 
-// Curved surfaces: the tile projected along the three axes, blended by the normal.
+// Curved surfaces: the tile projected along the three axes, blended by the normal, and
+// filtered isotropically (one mip level per projection).
 double curvedNoise(const Texture &t, const SurfacePoint &sp) {
     const Vec3 p = sp.local.cwiseProduct(t.stretch), dx = sp.dldx.cwiseProduct(t.stretch),
                dy = sp.dldy.cwiseProduct(t.stretch);
@@ -91,7 +104,8 @@ double curvedNoise(const Texture &t, const SurfacePoint &sp) {
     for (int a = 0; a < 3; ++a) {
         if (w[a] < 0.02) continue;
         const int i = other[a][0], j = other[a][1];
-        n += w[a] * noiseAt(t, p[i] + 131.0 * a * t.texel_mm[0], p[j], dx[i], dx[j], dy[i], dy[j]);
+        const double width = std::max(std::abs(dx[i]) + std::abs(dy[i]), std::abs(dx[j]) + std::abs(dy[j]));
+        n += w[a] * noiseAt(t, p[i] + 131.0 * a * t.texel_mm[0], p[j], width, width);
     }
     return n;
 }
@@ -103,10 +117,11 @@ double curvedNoise(const Texture &t, const SurfacePoint &sp) {
 Ripmap::Ripmap(const cv::Mat &level0, bool wrap)
     : width_(level0.cols), height_(level0.rows), channels_(level0.channels()), wrap_(wrap) {
     CV_Assert(level0.depth() == CV_32F && (channels_ == 1 || channels_ == 3) && !level0.empty());
+    invWidth_ = 1.0 / width_;
+    invHeight_ = 1.0 / height_;
     while ((width_ >> levelsX_) >= 1) ++levelsX_;
     while ((height_ >> levelsY_) >= 1) ++levelsY_;
     levels_.resize(static_cast<size_t>(levelsX_ * levelsY_));
-    auto pow2Mask = [](int n) { return (n & (n - 1)) == 0 ? n - 1 : -1; };
     for (int j = 0; j < levelsY_; ++j) {
         for (int i = 0; i < levelsX_; ++i) {
             Level &dst = levels_[static_cast<size_t>(j * levelsX_ + i)];
@@ -115,53 +130,47 @@ Ripmap::Ripmap(const cv::Mat &level0, bool wrap)
                 dst.pixels = level0.clone();
             else // halve the neighbour level along one axis (box average)
                 cv::resize(i > 0 ? level(i - 1, j).pixels : level(i, j - 1).pixels, dst.pixels, size, 0, 0, cv::INTER_AREA);
+            dst.data = dst.pixels.ptr<float>(0);
+            dst.stride = dst.pixels.step1();
+            dst.cols = size.width;
+            dst.rows = size.height;
             dst.scaleX = static_cast<float>(size.width) / static_cast<float>(width_);
             dst.scaleY = static_cast<float>(size.height) / static_cast<float>(height_);
-            dst.maskX = pow2Mask(size.width);
-            dst.maskY = pow2Mask(size.height);
         }
     }
 }
 
-void Ripmap::bilinear(int i, int j, float x, float y, float weight, float *out) const {
-    const Level &l = level(i, j);
-    const cv::Mat &m = l.pixels;
+void Ripmap::bilinear(const Level &l, float x, float y, float weight, float *out) const {
     const float lx = x * l.scaleX - 0.5f, ly = y * l.scaleY - 0.5f;
-    const float fx = std::floor(lx), fy = std::floor(ly);
-    const float ax = lx - fx, ay = ly - fy;
-    const long ix = static_cast<long>(fx), iy = static_cast<long>(fy);
-    int x0, x1, y0, y1;
+    int x0, y0, x1, y1;
+    float ax, ay;
     if (wrap_) {
-        if (l.maskX >= 0) {
-            x0 = static_cast<int>(ix & l.maskX);
-            x1 = static_cast<int>((ix + 1) & l.maskX);
-        } else {
-            x0 = wrapIndex(ix, m.cols);
-            x1 = x0 + 1 == m.cols ? 0 : x0 + 1;
-        }
-        if (l.maskY >= 0) {
-            y0 = static_cast<int>(iy & l.maskY);
-            y1 = static_cast<int>((iy + 1) & l.maskY);
-        } else {
-            y0 = wrapIndex(iy, m.rows);
-            y1 = y0 + 1 == m.rows ? 0 : y0 + 1;
-        }
+        // x, y lie in [0, size) (see sample()): lx, ly in [-0.5, cols - 0.5).
+        const int ix = static_cast<int>(lx + 1.0f) - 1, iy = static_cast<int>(ly + 1.0f) - 1;
+        ax = lx - static_cast<float>(ix);
+        ay = ly - static_cast<float>(iy);
+        x0 = ix < 0 ? l.cols - 1 : ix;
+        y0 = iy < 0 ? l.rows - 1 : iy;
+        x1 = ix + 1 >= l.cols ? 0 : ix + 1;
+        y1 = iy + 1 >= l.rows ? 0 : iy + 1;
     } else {
-        x0 = static_cast<int>(std::clamp<long>(ix, 0, m.cols - 1));
-        y0 = static_cast<int>(std::clamp<long>(iy, 0, m.rows - 1));
-        x1 = std::min(x0 + 1, m.cols - 1);
-        y1 = std::min(y0 + 1, m.rows - 1);
+        const float cx = std::clamp(lx, 0.0f, static_cast<float>(l.cols - 1)), cy = std::clamp(ly, 0.0f, static_cast<float>(l.rows - 1));
+        x0 = static_cast<int>(cx);
+        y0 = static_cast<int>(cy);
+        ax = cx - static_cast<float>(x0);
+        ay = cy - static_cast<float>(y0);
+        x1 = std::min(x0 + 1, l.cols - 1);
+        y1 = std::min(y0 + 1, l.rows - 1);
     }
-    const float *r0 = m.ptr<float>(y0), *r1 = m.ptr<float>(y1);
+    const float *r0 = l.data + static_cast<size_t>(y0) * l.stride, *r1 = l.data + static_cast<size_t>(y1) * l.stride;
     const float w00 = weight * (1 - ax) * (1 - ay), w10 = weight * ax * (1 - ay), w01 = weight * (1 - ax) * ay,
                 w11 = weight * ax * ay;
     if (channels_ == 1) {
         out[0] += w00 * r0[x0] + w10 * r0[x1] + w01 * r1[x0] + w11 * r1[x1];
         return;
     }
-    for (int c = 0; c < channels_; ++c)
-        out[c] += w00 * r0[x0 * channels_ + c] + w10 * r0[x1 * channels_ + c] + w01 * r1[x0 * channels_ + c] +
-                  w11 * r1[x1 * channels_ + c];
+    for (int c = 0; c < 3; ++c)
+        out[c] += w00 * r0[x0 * 3 + c] + w10 * r0[x1 * 3 + c] + w01 * r1[x0 * 3 + c] + w11 * r1[x1 * 3 + c];
 }
 
 void Ripmap::sample(double x, double y, double wx, double wy, float *out) const {
@@ -172,16 +181,23 @@ void Ripmap::sample(double x, double y, double wx, double wy, float *out) const 
     const double ly = wy > 1 ? std::min(fastLog2(wy), levelsY_ - 1.0) : 0.0;
     const int i0 = static_cast<int>(lx), j0 = static_cast<int>(ly);
     const float ax = static_cast<float>(lx - i0), ay = static_cast<float>(ly - j0);
-    // Single precision from here: bring a tiling raster's coordinates near the origin.
+    // Single precision from here: bring a tiling raster's coordinates into [0, size).
     if (wrap_) {
-        x -= std::floor(x / width_) * width_;
-        y -= std::floor(y / height_) * height_;
+        x -= fastFloor(x * invWidth_) * width_;
+        y -= fastFloor(y * invHeight_) * height_;
+        if (!(x < width_)) x = 0; // rounding, or coordinates beyond any sensible range
+        if (!(y < height_)) y = 0;
     }
     const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-    bilinear(i0, j0, fx, fy, (1 - ax) * (1 - ay), out);
-    if (ax > 0) bilinear(i0 + 1, j0, fx, fy, ax * (1 - ay), out);
-    if (ay > 0) bilinear(i0, j0 + 1, fx, fy, (1 - ax) * ay, out);
-    if (ax > 0 && ay > 0) bilinear(i0 + 1, j0 + 1, fx, fy, ax * ay, out);
+    if (i0 == j0 && ax == ay) { // isotropic: an ordinary mip-map, two lookups
+        bilinear(level(i0, i0), fx, fy, 1 - ax, out);
+        if (ax > 0) bilinear(level(i0 + 1, i0 + 1), fx, fy, ax, out);
+        return;
+    }
+    bilinear(level(i0, j0), fx, fy, (1 - ax) * (1 - ay), out);
+    if (ax > 0) bilinear(level(i0 + 1, j0), fx, fy, ax * (1 - ay), out);
+    if (ay > 0) bilinear(level(i0, j0 + 1), fx, fy, (1 - ax) * ay, out);
+    if (ax > 0 && ay > 0) bilinear(level(i0 + 1, j0 + 1), fx, fy, ax * ay, out);
 }
 
 // ---- Procedural patterns ----------------------------------------------------------------
@@ -190,9 +206,9 @@ double filteredChessboard(double x, double y, double wx, double wy) {
     // Per axis: the mean of the +-1 square wave (+1 where floor(p) is even) over
     // [p - w/2, p + w/2] (Inigo Quilez's analytic form); the board is their product.
     auto axis = [](double p, double w) {
-        if (w < 1e-4) return (static_cast<long>(std::floor(p)) & 1L) ? -1.0 : 1.0;
+        if (w < 1e-4) return (static_cast<long>(fastFloor(p)) & 1L) ? -1.0 : 1.0;
         w = std::min(w, 8.0);
-        auto tri = [](double q) { const double f = q * 0.5 - std::floor(q * 0.5); return std::abs(f - 0.5); };
+        auto tri = [](double q) { const double f = q * 0.5 - fastFloor(q * 0.5); return std::abs(f - 0.5); };
         return 2.0 * (tri(p - 0.5 * w) - tri(p + 0.5 * w)) / w;
     };
     return 0.5 - 0.5 * axis(x, wx) * axis(y, wy);
@@ -212,7 +228,7 @@ Texture texturePreset(const std::string &name) {
     static const Preset presets[] = {
         {"noise", {40, 40, 40}, {220, 220, 220}, 200, 6, 0.65, 1.6, 0, 1, 1},
         // Grass: busy detail down to a few millimetres, patches of lighter green.
-        {"turf", {45, 70, 25}, {150, 185, 80}, 600, 8, 0.75, 1.8, 0, 1, 11},
+        {"turf", {45, 70, 25}, {150, 185, 80}, 250, 7, 0.85, 2.2, 0, 1, 11},
         {"soil", {70, 50, 35}, {165, 130, 95}, 300, 8, 0.7, 1.6, 0, 1, 13},
         // Foliage: two-tone clumps of leaves with dark gaps.
         {"leaves", {20, 45, 15}, {110, 160, 60}, 250, 6, 0.7, 2.0, 1.0, 1, 17},
@@ -253,10 +269,11 @@ void bakeNoise(Texture &t) {
         return;
     }
 
-    // One tile spans four of the largest features; its texels resolve the finest octave
-    // (or as many octaves as 1024 texels allow). Sizes are powers of two, so each octave's
-    // lattice cell is a whole number of texels.
-    const double period = 4.0 * t.scale_mm;
+    // One tile spans sixteen of the largest features (a smaller tile shows its period on a
+    // ground seen at a grazing angle); its texels resolve the finest octave, or as many
+    // octaves as 1024 texels allow. Sizes are powers of two, so each octave's lattice cell
+    // is a whole number of texels.
+    const double period = 16.0 * t.scale_mm;
     const double finest = t.scale_mm / std::pow(2.0, t.octaves - 1);
     int n = 64;
     while (n < 1024 && period / n > finest / 2) n *= 2;
@@ -266,7 +283,7 @@ void bakeNoise(Texture &t) {
     cv::Mat tile(n, n, CV_32F, cv::Scalar(0));
     amplitude = 1;
     for (int i = 0; i < t.octaves; ++i, amplitude *= t.roughness) {
-        const int cells = 4 << i; // lattice cells per tile
+        const int cells = 16 << i; // lattice cells per tile
         if (cells * 2 > n) break; // finer than two texels: its filtered mean, zero, is what remains
         const int per = n / cells; // texels per cell
         const uint32_t seed = t.seed + 7919u * static_cast<uint32_t>(i);

@@ -40,13 +40,16 @@ public:
 private:
     struct Level {
         cv::Mat pixels;
+        const float *data = nullptr;   // pixels' first texel
+        size_t stride = 0;             // floats from one row to the next
+        int cols = 0, rows = 0;
         float scaleX = 1, scaleY = 1;  // level texels per level-0 texel
-        int maskX = -1, maskY = -1;    // size - 1 when a power of two (cheap wrapping), else -1
     };
-    void bilinear(int i, int j, float x, float y, float weight, float *out) const;
+    void bilinear(const Level &l, float x, float y, float weight, float *out) const;
     const Level &level(int i, int j) const { return levels_[static_cast<size_t>(j * levelsX_ + i)]; }
 
     int width_ = 0, height_ = 0, channels_ = 1, levelsX_ = 1, levelsY_ = 1;
+    double invWidth_ = 1, invHeight_ = 1;
     bool wrap_ = true;
     std::vector<Level> levels_;
 };
