@@ -221,6 +221,38 @@ TEST(SimGroundTruth, PanelFaceDisparityIsFocalTimesBaselineOverRange) {
     EXPECT_NEAR(f.gt_depth.at<float>(239, 0), 1500 * 384.615385 / (239 - 119.5), 0.5);
 }
 
+// Inclination as METHOD.md defines it: points of the ground truth, taken back to the
+// ground frame with Eq. 1, lie on the ground (Z = 0) or on the panel's face (Y = 6000).
+TEST(SimGroundTruth, InclinedRigFollowsEquationOne) {
+    RigSettings s;
+    s.inclination_deg = 10;
+    const sim::Scene scene = sim::Scene::builtIn();
+    const sim::StereoRig rig(s);
+    const sim::RenderedFrame f = sim::Renderer(rig, RenderSettings{}).render(scene, {}, 0);
+    const double th = 10 * CV_PI / 180, fpx = s.focalLengthPx(), cx = 159.5, cy = 119.5;
+    const uint16_t panel = scene.objects.at(0).id;
+    int ground = 0, face = 0;
+    for (int v = 0; v < f.gt_depth.rows; ++v)
+        for (int u = 0; u < f.gt_depth.cols; ++u) {
+            const double zc = f.gt_depth.at<float>(v, u);
+            if (zc <= 0) continue;
+            const double xc = (u - cx) / fpx * zc, yc = (v - cy) / fpx * zc;
+            const double Y = zc * std::cos(th) - yc * std::sin(th), Z = 1500 - zc * std::sin(th) - yc * std::cos(th); // Eq. 1
+            const uint16_t id = f.gt_object_id.at<uint16_t>(v, u);
+            if (id == sim::Scene::kGroundId) {
+                EXPECT_NEAR(Z, 0, 1e-3 * zc) << "ground pixel " << u << "," << v;
+                ++ground;
+            } else if (id == panel && std::abs(Y - 6000) < 1) {
+                EXPECT_GE(Z, -1e-6);
+                EXPECT_LE(Z, 2000 + 1e-6);
+                EXPECT_LE(std::abs(xc), 1250 + 1e-6);
+                ++face;
+            }
+        }
+    EXPECT_GT(ground, 10000);
+    EXPECT_GT(face, 500);
+}
+
 TEST(SimScene, RangeMovesTheMainObjectAndMetadataFollowsTheRig) {
     sim::Scene scene = sim::Scene::builtIn();
     scene.placeMainObjectAtRange(12000);
