@@ -136,6 +136,28 @@ TEST(SimPlugin, ColourAndSeed) {
     EXPECT_GT(cv::norm(fa->left(), fc->left(), cv::NORM_INF), 0);
 }
 
+TEST(SimPlugin, RightImagerGainOffsetAndBinning) {
+    auto even = makeSim("{noise_sigma: 0}"), dim = makeSim("{noise_sigma: 0, gain_right: 0.8, offset_right: 10}");
+    auto a = even->grab(), b = dim->grab();
+    EXPECT_EQ(cv::norm(a->left(), b->left(), cv::NORM_INF), 0) << "the left imager is the reference";
+    // Sky (top rows, no texture): right = 0.8 * left + 10, within rounding.
+    const double left = cv::mean(a->right()(cv::Rect(0, 0, 320, 20)))[0], right = cv::mean(b->right()(cv::Rect(0, 0, 320, 20)))[0];
+    EXPECT_NEAR(right, 0.8 * left + 10, 0.6);
+
+    // Binning 2: the noise of an output pixel is noise_sigma / 2.
+    auto noisy = makeSim("{noise_sigma: 4, seed: 1}"), binned = makeSim("{noise_sigma: 4, seed: 1, binning: 2}");
+    auto n1 = noisy->grab(), n2 = binned->grab();
+    const cv::Mat clean = a->left();
+    cv::Mat d1, d2;
+    cv::subtract(n1->left(), clean, d1, cv::noArray(), CV_32F);
+    cv::subtract(n2->left(), clean, d2, cv::noArray(), CV_32F);
+    cv::Scalar m, sd1, sd2;
+    cv::meanStdDev(d1(cv::Rect(0, 0, 320, 60)), m, sd1); // sky: no edges to supersample differently
+    cv::meanStdDev(d2(cv::Rect(0, 0, 320, 60)), m, sd2);
+    EXPECT_NEAR(sd1[0], 4.0, 0.3);
+    EXPECT_NEAR(sd2[0], 2.0, 0.2);
+}
+
 TEST(SimPlugin, E2TreeSceneGivesTheMarkerPosition) {
     auto src = makeSim("{scene: '" + std::string(BINOCLE_SOURCE_DIR) + "/configs/scenes/e2_tree.yaml', range_mm: 7000}");
     auto f = src->grab();
