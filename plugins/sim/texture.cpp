@@ -67,11 +67,11 @@ Rgb mix(const Rgb &a, const Rgb &b, double t) { return a + (b - a) * static_cast
 // ground near the horizon would show the tile's columns as streaks.
 inline double noiseAt(const Texture &t, double u, double v, double wu, double wv) {
     float n = 0;
-    t.raster->sample(u / t.texel_mm[0], v / t.texel_mm[1], wu / t.texel_mm[0], wv / t.texel_mm[1], &n);
-    const double period = t.raster->width() * t.texel_mm[0];
+    const double ku = t.texels_per_mm[0], kv = t.texels_per_mm[1];
+    t.raster->sample(u * ku, v * kv, wu * ku, wv * kv, &n);
     double gain = 1;
-    if (wu > period) gain *= std::sqrt(period / wu);
-    if (wv > period) gain *= std::sqrt(period / wv);
+    if (wu > t.period_mm) gain *= std::sqrt(t.period_mm / wu);
+    if (wv > t.period_mm) gain *= std::sqrt(t.period_mm / wv);
     return gain * n;
 }
 
@@ -80,7 +80,7 @@ inline double noiseAt(const Texture &t, double u, double v, double wu, double wv
 // lookup drifts by more than a feature, so the texture never repeats and a matcher finds
 // no period. The warp stretches the pattern by at most 10 %, which the footprint ignores.
 double planarNoise(const Texture &t, const SurfacePoint &sp) {
-    const double period = t.raster->width() * t.texel_mm[0];
+    const double period = t.period_mm;
     // A periodic wave in [-0.5, 0.5] with continuous slope (two smoothsteps), slope <= 3.
     auto wave = [](double q) {
         double f = q - fastFloor(q);
@@ -105,7 +105,7 @@ double curvedNoise(const Texture &t, const SurfacePoint &sp) {
         if (w[a] < 0.02) continue;
         const int i = other[a][0], j = other[a][1];
         const double width = std::max(std::abs(dx[i]) + std::abs(dy[i]), std::abs(dx[j]) + std::abs(dy[j]));
-        n += w[a] * noiseAt(t, p[i] + 131.0 * a * t.texel_mm[0], p[j], width, width);
+        n += w[a] * noiseAt(t, p[i] + 0.37 * a * t.period_mm, p[j], width, width); // offset: other patterns
     }
     return n;
 }
@@ -259,21 +259,22 @@ void bakeNoise(Texture &t) {
     // of an experiment) bakes nothing.
     using Key = std::tuple<double, int, double, uint32_t>;
     static std::mutex mutex;
-    static std::map<Key, std::pair<std::weak_ptr<const Ripmap>, double>> cache;
+    static std::map<Key, std::weak_ptr<const Ripmap>> cache;
     const Key key{t.scale_mm, t.octaves, t.roughness, t.seed};
     std::lock_guard<std::mutex> lock(mutex);
+    // One tile spans sixteen of the largest features (a smaller tile shows its period on a
+    // ground seen at a grazing angle).
+    t.period_mm = 16.0 * t.scale_mm;
     auto &cached = cache[key];
-    if (auto raster = cached.first.lock()) {
+    if (auto raster = cached.lock()) {
         t.raster = raster;
-        t.texel_mm[0] = t.texel_mm[1] = cached.second;
+        t.texels_per_mm[0] = t.texels_per_mm[1] = raster->width() / t.period_mm;
         return;
     }
 
-    // One tile spans sixteen of the largest features (a smaller tile shows its period on a
-    // ground seen at a grazing angle); its texels resolve the finest octave, or as many
-    // octaves as 1024 texels allow. Sizes are powers of two, so each octave's lattice cell
-    // is a whole number of texels.
-    const double period = 16.0 * t.scale_mm;
+    // Texels resolve the finest octave, or as many octaves as 1024 texels allow. Sizes are
+    // powers of two, so each octave's lattice cell is a whole number of texels.
+    const double period = t.period_mm;
     const double finest = t.scale_mm / std::pow(2.0, t.octaves - 1);
     int n = 64;
     while (n < 1024 && period / n > finest / 2) n *= 2;
@@ -308,8 +309,8 @@ void bakeNoise(Texture &t) {
         });
     }
     t.raster = std::make_shared<const Ripmap>(tile, true);
-    t.texel_mm[0] = t.texel_mm[1] = texel;
-    cached = {t.raster, texel};
+    t.texels_per_mm[0] = t.texels_per_mm[1] = n / period;
+    cached = t.raster;
 }
 
 void setImage(Texture &t, const cv::Mat &bgr) {
@@ -318,8 +319,8 @@ void setImage(Texture &t, const cv::Mat &bgr) {
     rgb.convertTo(rgb, CV_32FC3, 1.0 / 255);
     t.kind = TextureKind::Image;
     t.raster = std::make_shared<const Ripmap>(rgb, true);
-    t.texel_mm[0] = t.size_mm[0] / rgb.cols;
-    t.texel_mm[1] = t.size_mm[1] / rgb.rows;
+    t.texels_per_mm[0] = rgb.cols / t.size_mm[0];
+    t.texels_per_mm[1] = rgb.rows / t.size_mm[1];
 }
 
 Rgb evalTexture(const Texture &t, const SurfacePoint &sp) {
@@ -342,9 +343,9 @@ Rgb evalTexture(const Texture &t, const SurfacePoint &sp) {
     case TextureKind::Image: {
         // u to the right, v upwards; the image's first row is its top.
         float c[3];
-        t.raster->sample(sp.u / t.texel_mm[0], (t.size_mm[1] - sp.v) / t.texel_mm[1],
-                         (std::abs(sp.dudx) + std::abs(sp.dudy)) / t.texel_mm[0],
-                         (std::abs(sp.dvdx) + std::abs(sp.dvdy)) / t.texel_mm[1], c);
+        const double ku = t.texels_per_mm[0], kv = t.texels_per_mm[1];
+        t.raster->sample(sp.u * ku, (t.size_mm[1] - sp.v) * kv, (std::abs(sp.dudx) + std::abs(sp.dudy)) * ku,
+                         (std::abs(sp.dvdx) + std::abs(sp.dvdy)) * kv, c);
         return Rgb(c[0], c[1], c[2]);
     }
     }

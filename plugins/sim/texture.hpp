@@ -84,10 +84,11 @@ struct Texture {
     Vec3 stretch{1, 1, 1};                 // noise on curved shapes: per-axis frequency factor
     uint32_t seed = 1;
     double size_mm[2] = {1000, 1000};      // image: extent of one copy on the surface (u, v)
-    // Noise and image: the baked raster (noise: one channel in [-1, 1]; image: RGB 0..1)
-    // and the size of one of its texels on the surface, mm (u, v).
+    // Noise and image: the baked raster (noise: one channel in [-1, 1]; image: RGB 0..1),
+    // its texels per mm on the surface (u, v), and (noise) the tile's side in mm.
     std::shared_ptr<const Ripmap> raster;
-    double texel_mm[2] = {1, 1};
+    double texels_per_mm[2] = {1, 1};
+    double period_mm = 1;
 };
 
 // Procedural texture presets ("turf", "soil", "leaves", "bark", "noise") with their
