@@ -278,7 +278,6 @@ void bakeNoise(Texture &t) {
     const double finest = t.scale_mm / std::pow(2.0, t.octaves - 1);
     int n = 64;
     while (n < 1024 && period / n > finest / 2) n *= 2;
-    const double texel = period / n;
     double norm = 0, amplitude = 1;
     for (int i = 0; i < t.octaves; ++i, amplitude *= t.roughness) norm += amplitude;
     cv::Mat tile(n, n, CV_32F, cv::Scalar(0));
