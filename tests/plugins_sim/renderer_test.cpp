@@ -3,6 +3,8 @@
 // seeded noise, rectification with the published calibration, ground truth.
 #include "sim_test_util.hpp"
 
+#include "common/test_util.hpp"
+
 #include "core/calibration.hpp"
 #include "metadata.hpp"
 #include "renderer.hpp"
@@ -10,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <iostream>
@@ -286,6 +289,30 @@ TEST(SimScene, ErrorsNameFileLineAndKey) {
     EXPECT_NE(e.find("scale_mm = -4: expected a value > 0"), std::string::npos) << e;
     e = error("main_object: tree\nobjects: []\n");
     EXPECT_NE(e.find("no object named 'tree'"), std::string::npos) << e;
+}
+
+// An image texture tiles a face with its top row up: a picture red above, blue below,
+// on a box facing the rig, seen in colour.
+TEST(SimScene, ImageTextureAppearsUprightOnAFace) {
+    TempDir dir;
+    cv::Mat picture(64, 64, CV_8UC3, cv::Scalar(255, 0, 0)); // BGR: blue
+    picture(cv::Rect(0, 0, 64, 32)).setTo(cv::Scalar(0, 0, 255)); // top half red
+    ASSERT_TRUE(cv::imwrite(dir.str("picture.png"), picture));
+    const sim::Scene scene = sim::Scene::fromYaml(
+        "ground: none\nlight: {ambient: 1}\nobjects:\n"
+        "  - {name: sign, type: box, center_mm: [0, 5000, 1500], size_mm: [1000, 10, 1000],\n"
+        "     texture: {type: image, file: picture.png, size_mm: [1000, 1000]}}\n",
+        "sign.yaml", dir.str());
+    RenderSettings colour = exact(2);
+    colour.color = true;
+    const sim::StereoRig rig(RigSettings{});
+    const sim::RenderedFrame f = sim::Renderer(rig, colour).render(scene, {}, 0);
+    // The sign spans 1000 mm * 384.6 / 5000 mm = 77 px around the image centre.
+    const cv::Vec3b above = f.left.at<cv::Vec3b>(100, 160), below = f.left.at<cv::Vec3b>(140, 160);
+    EXPECT_GT(above[2], 200);
+    EXPECT_LT(above[0], 50);
+    EXPECT_GT(below[0], 200);
+    EXPECT_LT(below[2], 50);
 }
 
 TEST(SimScene, SceneFilesOfTheRepositoryLoad) {
