@@ -19,10 +19,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kEpsilon = 1e-6; // mm: hits closer than this to the origin are ignored
 
-// Slab test against axis-aligned bounds lo..hi; true when the ray enters them before tMax,
-// `entry` the distance where it does (0 when it starts inside). Written out per axis: the
-// hottest few lines of the renderer.
-inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3 &hi, double tMax, double &entry) {
+// Slab test against axis-aligned bounds lo..hi; true when the ray enters them before
+// tMax. Written out per axis: the hottest few lines of the renderer.
+inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3 &hi, double tMax) {
     // NaN (0 * inf, a ray in a slab's plane) loses every comparison: it leaves tn / tf as they are.
     const double x1 = (lo.x() - o.x()) * inv.x(), x2 = (hi.x() - o.x()) * inv.x();
     const double y1 = (lo.y() - o.y()) * inv.y(), y2 = (hi.y() - o.y()) * inv.y();
@@ -36,7 +35,6 @@ inline bool hitBounds(const Vec3 &o, const Vec3 &inv, const Vec3 &lo, const Vec3
     grow(x1, x2);
     grow(y1, y2);
     grow(z1, z2);
-    entry = tn;
     return tn <= tf;
 }
 
@@ -300,8 +298,7 @@ bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
     while (top > 0) {
         const int index = stack[--top];
         const Node &node = nodes_[static_cast<size_t>(index)];
-        double entry = 0;
-        if (!hitBounds(o, inv, node.lo, node.hi, best, entry)) continue;
+        if (!hitBounds(o, inv, node.lo, node.hi, best)) continue;
         if (node.count > 0) {
             for (int k = node.first; k < node.first + node.count; ++k) {
                 const int i = order_[static_cast<size_t>(k)];
