@@ -61,6 +61,33 @@ std::string frameMetadata(const Scene &scene, const StereoRig &rig, const RigPos
         break;
     }
 
+    // Calibration mode: the board's true pose in the left camera frame (OpenCV axes):
+    // inner corner (i, j) lies at origin + i * square * x_axis + j * square * y_axis.
+    for (const SceneObject &o : scene.objects) {
+        if (o.type != "calibration_board") continue;
+        const Primitive &p = scene.primitives[static_cast<size_t>(o.firstPrimitive)];
+        const Texture &t = scene.textures[static_cast<size_t>(p.texture[3])];
+        const Camera left = rig.left(pose);
+        // Face -Y of the box: u along its +X, v along its +Z, from the face's corner.
+        const Vec3 corner = p.center + p.rotation * Vec3(-p.half.x(), -p.half.y(), -p.half.z());
+        const Vec3 ux = p.rotation.col(0), vz = p.rotation.col(2);
+        const Vec3 origin = corner + (t.margin_mm + t.square_mm) * (ux + vz);
+        auto inCamera = [&](const Vec3 &v) { return Vec3(left.rotation.transpose() * v); };
+        e << YAML::Key << "board" << YAML::Value << YAML::BeginMap;
+        e << YAML::Key << "cols" << YAML::Value << t.board_squares[0] - 1;
+        e << YAML::Key << "rows" << YAML::Value << t.board_squares[1] - 1;
+        e << YAML::Key << "square_mm" << YAML::Value << t.square_mm;
+        e << YAML::Key << "origin_camera_mm" << YAML::Value;
+        emitVec(e, inCamera(origin - left.center));
+        e << YAML::Key << "x_axis_camera" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (double c : inCamera(ux)) e << c;
+        e << YAML::EndSeq;
+        e << YAML::Key << "y_axis_camera" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (double c : inCamera(vz)) e << c;
+        e << YAML::EndSeq;
+        e << YAML::EndMap;
+    }
+
     e << YAML::Key << "objects" << YAML::Value << YAML::BeginSeq;
     for (const SceneObject &o : scene.objects) {
         const Vec3 lo = o.boundsMin - shift, hi = o.boundsMax - shift;
