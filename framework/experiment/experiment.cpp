@@ -537,7 +537,7 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
             int frames = 0;
             pipeline.run(run, [&](const FrameResult &fr) {
                 ++frames;
-                valid += fr.disparity.empty() ? 0.0 : double(cv::countNonZero(fr.disparity > 0)) / fr.disparity.total();
+                valid += fr.valid_pixel_ratio;
                 for (const auto &[name, value] : fr.figures) {
                     auto it = std::find_if(sums.begin(), sums.end(), [&](const auto &p) { return p.first == name; });
                     if (it == sums.end()) {

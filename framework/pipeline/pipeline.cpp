@@ -88,6 +88,7 @@ FrameResult Pipeline::process(const LentFrame &frame) {
         cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
     }
     r.disparity = matcher_->compute(r.rectified_left, r.rectified_right);
+    r.valid_pixel_ratio = static_cast<double>(cv::countNonZero(r.disparity > 0)) / static_cast<double>(r.disparity.total());
     r.cloud = cloudFromDisparity(r.disparity, calibration_, r.rectified_left, rig_.outputs.max_range_mm);
     for (auto &t : transforms_) {
         binocle_cloud view = r.cloud.view();
@@ -215,10 +216,9 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
             if (!frame) break;
             FrameResult r = process(*frame);
             if (!outDir_.empty()) writeOutputs(r, outDir_);
-            const double valid = r.disparity.empty() ? 0.0 : static_cast<double>(cv::countNonZero(r.disparity > 0)) / r.disparity.total();
             Json f = Json::object();
             f.set("sequence", r.sequence);
-            f.set("valid_pixel_ratio", valid);
+            f.set("valid_pixel_ratio", r.valid_pixel_ratio);
             f.set("points", static_cast<uint64_t>(r.cloud.size()));
             f.set("seconds", r.seconds);
             f.set("metrics", r.metrics);

@@ -28,6 +28,7 @@ struct FrameResult {
     uint64_t sequence = 0;
     cv::Mat rectified_left, rectified_right;
     cv::Mat disparity; // CV_32F
+    double valid_pixel_ratio = 0; // share of pixels with a disparity
     Cloud cloud;       // after transforms
     Json metrics;      // {evaluator: {metric: value}}
     std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
