@@ -9,7 +9,11 @@ packages=(
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli
   libdc1394-dev libv4l-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  opencv-doc util-linux iproute2
+  opencv-doc util-linux iproute2 ccache
+  libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
+  clang libfuzzer-14-dev abigail-tools
+  chromium chromium-driver python3-selenium
+  slurm-wlm munge
 )
 
 missing=()
