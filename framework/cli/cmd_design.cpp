@@ -23,10 +23,10 @@ namespace binocle::cli {
 namespace {
 
 struct DesignArgs {
-    std::string range, band, lenses = "2.8,4,8,12,16", baselines = "100:200:10";
-    double pixel_pitch_um = 20.8, camera_height_mm = 1500, inclination_deg = 0;
+    std::string range, band, lenses = method::kVidereLensesMm, baselines = "100:200:10";
+    double pixel_pitch_um = method::kViderePixelPitchUm, camera_height_mm = 1500, inclination_deg = 0;
     double panel_width_mm = 2500, panel_height_mm = 2000;
-    int image_width = 320, image_height = 240, num_disparities = 64;
+    int image_width = method::kVidereImageWidthPx, image_height = method::kVidereImageHeightPx, num_disparities = 64;
     int top = 10, simulate_count = 12;
     bool simulate = false, quiet = false;
     std::string rig, out;
@@ -67,13 +67,6 @@ struct Candidate {
     double eta_3d = NAN;                   // --simulate
 };
 
-// How far FF lies from the paper's best band 1.2-2.0 (0 inside), in log terms so that
-// 0.6 and 4.0 (both a factor 2 off) weigh alike.
-double ffDistance(double ff) {
-    if (ff >= 1.2 && ff <= 2.0) return 0;
-    return ff < 1.2 ? std::log(1.2 / ff) : std::log(ff / 2.0);
-}
-
 int design(const DesignArgs &args) {
     std::vector<double> ranges;
     if (!args.range.empty()) ranges = numberList("--range", args.range);
@@ -111,7 +104,7 @@ int design(const DesignArgs &args) {
             for (double r : ranges) {
                 c.at.push_back(method::designFigures(head, r, 0.25, &panel));
                 const auto &x = c.at.back();
-                c.worst_ff_distance = std::max(c.worst_ff_distance, ffDistance(x.form_factor));
+                c.worst_ff_distance = std::max(c.worst_ff_distance, method::formFactorBandDistance(x.form_factor));
                 c.panel_fits = c.panel_fits && x.panel_fits_width;
                 c.in_search = c.in_search && (!std::isfinite(x.min_range_mm) || x.min_range_mm <= r);
             }
@@ -214,7 +207,7 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
               "Ranks every combination of the available baselines and lenses for the target\n"
               "range(s): configurations that see the whole test panel and whose disparity search\n"
               "reaches the range first, then by how close the form factor FF = 10·B·f/R (Eq. 7)\n"
-              "lies to the paper's best band 1.2-2.0 (worst range of the band counts), then by\n"
+              "lies to the paper's best band (1.2-2.0, METHOD.md; the worst range of the band counts), then by\n"
               "depth resolution. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
               "depth resolution dR = R²·p·Δd/(B·f) for Δd = 0.25 px, the minimum range of the\n"
               "disparity search and whether the panel fits the stereo field.\n"
@@ -224,11 +217,11 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
                   app.add_option("--range", a->range, "target range(s) in mm, e.g. 6000,12000")->type_name("MM[,MM...]");
                   app.add_option("--band", a->band, "a range band in mm (5 ranges across it), e.g. 5000,12000")
                                    ->type_name("MIN,MAX");
-                  app.add_option("--lenses", a->lenses, "focal lengths available, mm (default: the Videre set 2.8,4,8,12,16)")
+                  app.add_option("--lenses", a->lenses, std::string("focal lengths available, mm (default: the Videre set ") + method::kVidereLensesMm + ")")
                       ->type_name("MM,MM...");
                   app.add_option("--baselines", a->baselines, "baselines, mm: MIN:MAX:STEP or a list (default 100:200:10)")
                       ->type_name("SPEC");
-                  app.add_option("--pixel-pitch-um", a->pixel_pitch_um, "effective pixel pitch (default 20.8: Videre head decimated by 4)")
+                  app.add_option("--pixel-pitch-um", a->pixel_pitch_um, "effective pixel pitch (default: the Videre head decimated by 4, 20.8)")
                       ->type_name("UM")
                       ->check(positiveNumber());
                   app.add_option("--image-width", a->image_width, "image width in pixels (default 320)")->type_name("PX")->check(atLeast(1));

@@ -83,18 +83,72 @@ struct Reader {
     }
 };
 
-// The rig paths a variable goes to, when the experiment does not say: the source's key
-// of the same name, and the ground transform for height and inclination.
-std::map<std::string, std::vector<std::string>> defaultBind(const YAML::Node &rig) {
+// The settings table of the plugin a rig block names; empty when the block or the plugin
+// is missing (the rig's own validation says so, with its position).
+std::vector<binocle_param_desc> settingsOf(const YAML::Node &block, int32_t kind, const PluginHost &host) {
+    if (!block.IsMap() || !block["plugin"] || !block["plugin"].IsScalar()) return {};
+    const PluginRecord *p = host.find(block["plugin"].Scalar(), kind);
+    return p ? p->params() : std::vector<binocle_param_desc>{};
+}
+
+const binocle_param_desc *setting(const std::vector<binocle_param_desc> &table, const std::string &name) {
+    for (const auto &d : table)
+        if (d.name && name == d.name) return &d;
+    return nullptr;
+}
+
+// The rig paths a variable goes to, when the experiment does not say: every block of the
+// rig whose plugin has a setting of that name (the source re-posed per test, a transform
+// that takes camera_height_mm / inclination_deg). Found in the plugins' settings tables,
+// so an experiment on any source or transform works without knowing them by name.
+std::map<std::string, std::vector<std::string>> defaultBind(const YAML::Node &rig, const PluginHost &host) {
     std::map<std::string, std::vector<std::string>> b;
-    for (const auto &v : kVariables) b[v] = {"source." + v};
+    const auto source = settingsOf(rig["source"], BINOCLE_KIND_STEREO_SOURCE, host);
+    for (const auto &v : kVariables) {
+        b[v];
+        if (setting(source, v)) b[v].push_back("source." + v);
+    }
     if (YAML::Node t = rig["transforms"]; t && t.IsSequence())
-        for (size_t i = 0; i < t.size(); ++i)
-            if (t[i]["plugin"] && t[i]["plugin"].as<std::string>() == "ground") {
-                b["camera_height_mm"].push_back("transforms." + std::to_string(i) + ".camera_height_mm");
-                b["inclination_deg"].push_back("transforms." + std::to_string(i) + ".inclination_deg");
-            }
+        for (size_t i = 0; i < t.size(); ++i) {
+            const auto table = settingsOf(t[i], BINOCLE_KIND_CLOUD_TRANSFORM, host);
+            for (const auto &v : kVariables)
+                if (setting(table, v)) b[v].push_back("transforms." + std::to_string(i) + "." + v);
+        }
     return b;
+}
+
+// A number the rig's source states for `key`, else the default of its plugin's setting of
+// that name (e.g. a simulated head's pixel pitch); 0 when neither says.
+double sourceFigure(const YAML::Node &rig, const std::string &key, const PluginHost &host) {
+    const YAML::Node source = rig["source"];
+    double v = 0;
+    if (source.IsMap() && source[key] && YAML::convert<double>::decode(source[key], v)) return v;
+    const auto *d = setting(settingsOf(source, BINOCLE_KIND_STEREO_SOURCE, host), key);
+    if (d && d->default_value) {
+        try {
+            if (YAML::convert<double>::decode(YAML::Load(d->default_value), v)) return v;
+        } catch (const YAML::Exception &) {
+        }
+    }
+    return 0;
+}
+
+// A variable the tests set that goes nowhere in the rig is recorded in the results but
+// changes nothing in the run: say so once, before anything runs.
+void warnUnbound(const Experiment &e) {
+    for (const auto &v : kVariables) {
+        const auto it = e.bind.find(v);
+        if (it != e.bind.end() && !it->second.empty()) continue;
+        TestGeometry first = e.tests.front().geometry;
+        const bool varies = std::any_of(e.tests.begin(), e.tests.end(), [&](const ExperimentTest &t) {
+            TestGeometry g = t.geometry;
+            return *field(g, v) != *field(first, v);
+        });
+        if (varies)
+            spdlog::warn("experiment {}: the tests set different {} but no plugin of the rig has such a setting (and `bind:` "
+                         "names none): it is recorded in the results, not applied",
+                         e.name, v);
+    }
 }
 
 void checkGeometry(const Experiment &e, const ExperimentTest &t, const Reader &r, const YAML::Node &node) {
@@ -178,15 +232,14 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         e.baseline_min_mm = b[0];
         e.baseline_max_mm = b[1];
     }
-    if (root["pixel_pitch_um"]) e.pixel_pitch_um = r.number(root["pixel_pitch_um"], "pixel_pitch_um");
-    else if (e.rig["source"] && e.rig["source"]["pixel_pitch_um"]) e.pixel_pitch_um = e.rig["source"]["pixel_pitch_um"].as<double>();
-    else if (e.rig["source"] && e.rig["source"]["plugin"] && e.rig["source"]["plugin"].as<std::string>() == "sim")
-        e.pixel_pitch_um = 20.8; // the sim's default: the Videre head's effective pixel
-    if (root["image_width_px"]) e.image_width_px = static_cast<int>(r.number(root["image_width_px"], "image_width_px"));
-    else if (e.rig["source"] && e.rig["source"]["image_width"]) e.image_width_px = e.rig["source"]["image_width"].as<int>();
-    else if (e.pixel_pitch_um == 20.8) e.image_width_px = 320;
+    // The sensor figures: the experiment's, else what the source states or its plugin's
+    // defaults (a simulated head); a source that states none gets no sensor-aware columns.
+    e.pixel_pitch_um = root["pixel_pitch_um"] ? r.number(root["pixel_pitch_um"], "pixel_pitch_um")
+                                              : sourceFigure(e.rig, "pixel_pitch_um", host);
+    e.image_width_px = static_cast<int>(root["image_width_px"] ? r.number(root["image_width_px"], "image_width_px")
+                                                               : sourceFigure(e.rig, "image_width", host));
 
-    e.bind = defaultBind(e.rig);
+    e.bind = defaultBind(e.rig, host);
     if (YAML::Node b = root["bind"]) {
         if (!b.IsMap()) r.fail(b, "bind: expected a map variable -> list of rig paths");
         r.checkKeys(b, kVariables, "bind");
@@ -283,6 +336,7 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
                     {"bars", "eta_2d_percent", "", e.name + ": planar efficiency η2D per test", "eta_2d_bars", {70}},
                     {"scatter", "eta_3d_percent", "form_factor", e.name + ": η3D against the form factor FF", "eta_3d_vs_ff", {}}};
     }
+    warnUnbound(e);
     return e;
 }
 
@@ -299,7 +353,7 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     } catch (const YAML::Exception &x) {
         throw Error(e.rig_file + ": cannot read YAML: " + x.msg);
     }
-    e.bind = defaultBind(e.rig);
+    e.bind = defaultBind(e.rig, host);
     for (size_t i = 0; i < tests.size(); ++i) {
         ExperimentTest t;
         t.id = std::to_string(i + 1);
@@ -308,6 +362,7 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
         e.tests.push_back(t);
     }
     e.charts = {{"scatter", "eta_3d_percent", "form_factor", name + ": η3D against the form factor FF", "eta_3d_vs_ff", {}}};
+    warnUnbound(e);
     return e;
 }
 
@@ -421,8 +476,8 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
             c.x_label = axisLabel(spec.x);
             c.y_label = axisLabel(spec.metric);
             if (spec.x == "form_factor") {
-                c.band_min = 1.2; // the paper's best FF band
-                c.band_max = 2.0;
+                c.band_min = method::kBestFormFactorBand.min;
+                c.band_max = method::kBestFormFactorBand.max;
             }
             std::vector<double> ranges;
             for (const auto &r : rows) {

@@ -37,10 +37,16 @@ double focalLengthForFormFactor(double ff, double baseline_mm, double range_mm) 
 
 const char *formFactorReading(double ff) {
     if (!std::isfinite(ff)) return "unknown";
-    if (ff < 1.0) return "low";
-    if (ff < 1.2) return "fair";
-    if (ff <= 2.0) return "best";
+    if (ff < kFairFormFactorMin) return "low";
+    if (ff < kBestFormFactorBand.min) return "fair";
+    if (ff <= kBestFormFactorBand.max) return "best";
     return "high";
+}
+
+double formFactorBandDistance(double ff) {
+    const auto [lo, hi] = kBestFormFactorBand;
+    if (ff >= lo && ff <= hi) return 0;
+    return ff < lo ? std::log(lo / ff) : std::log(ff / hi);
 }
 
 // d = B f / (R p), p converted from um to mm.

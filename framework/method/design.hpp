@@ -5,6 +5,24 @@
 
 namespace binocle::method {
 
+// The figures of the paper (METHOD.md), in one place: `design` and `experiment` read them.
+struct FormFactorBand {
+    double min, max;
+};
+// Eq. 7's best band: the configurations of E1 with the best η3D.
+inline constexpr FormFactorBand kBestFormFactorBand{1.2, 2.0};
+// Below this FF a configuration reads "low", up to the best band "fair".
+inline constexpr double kFairFormFactorMin = 1.0;
+// The paper's Videre head as its experiments used it (images decimated by 4): the
+// effective pixel pitch, the image size and its lens set.
+inline constexpr double kViderePixelPitchUm = 20.8;
+inline constexpr int kVidereImageWidthPx = 320, kVidereImageHeightPx = 240;
+inline constexpr const char *kVidereLensesMm = "2.8,4,8,12,16";
+
+// How far FF lies from the best band (0 inside), in log terms so that 0.6 and 4.0 (both
+// a factor 2 off) weigh alike.
+double formFactorBandDistance(double ff);
+
 // Eq. 7: FF = 10 * B * f / R, with baseline B, focal length f and range R all in mm.
 double formFactor(double baseline_mm, double focal_length_mm, double range_mm);
 // Eq. 7 solved for f: the focal length (mm) that gives form factor `ff` at range R.

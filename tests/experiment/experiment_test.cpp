@@ -74,6 +74,34 @@ TEST(Experiment, TheShippedExperimentsAreValid) {
     EXPECT_EQ(loadExperiment(BINOCLE_SOURCE_DIR "/configs/experiments/e2.yaml", host).tests.size(), 8u);
 }
 
+// The runner knows no plugin by name: where each variable goes and the sensor figures come
+// from the plugins' settings tables.
+TEST(Experiment, BindingAndSensorFiguresComeFromTheSettingsTables) {
+    PluginHost host;
+    host.scan();
+    Experiment e1 = loadExperiment(BINOCLE_SOURCE_DIR "/configs/experiments/e1.yaml", host);
+    EXPECT_EQ(e1.bind["range_mm"], std::vector<std::string>{"source.range_mm"});
+    EXPECT_EQ(e1.bind["inclination_deg"], (std::vector<std::string>{"source.inclination_deg", "transforms.0.inclination_deg"}));
+    EXPECT_DOUBLE_EQ(e1.pixel_pitch_um, 20.8); // the simulated head's default pixel pitch
+    EXPECT_EQ(e1.image_width_px, 320);
+
+    // A source that cannot be re-posed (files): the variables are recorded, not applied,
+    // and the experiment still runs.
+    TempDir dir;
+    const std::string file = dir.str("files.yaml");
+    writeText(file, "name: files\nrig: " BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml\ntests:\n"
+                    "  - {id: near, range_mm: 1000, baseline_mm: 100, focal_length_mm: 8}\n"
+                    "  - {id: far, range_mm: 2000, baseline_mm: 100, focal_length_mm: 8}\n");
+    Experiment files = loadExperiment(file, host);
+    EXPECT_TRUE(files.bind["range_mm"].empty());
+    EXPECT_EQ(files.bind["camera_height_mm"], std::vector<std::string>{"transforms.0.camera_height_mm"});
+    auto r = runCli("experiment " + file + " --quiet --out " + dir.str("out"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("the tests set different range_mm but no plugin of the rig has such a setting"), std::string::npos)
+        << r.output;
+    EXPECT_NE(readTextFile(dir.str("out/results.csv")).find("far,ok,100,8,2000"), std::string::npos);
+}
+
 TEST(Experiment, RunWritesTablesChartsAndPerTestOutputs) {
     TempDir dir;
     const std::string file = dir.str("two.yaml");
