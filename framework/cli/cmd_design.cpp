@@ -8,7 +8,9 @@
 #include "core/error.hpp"
 #include "core/json.hpp"
 #include "experiment/experiment.hpp"
+#include "experiment/predictor_choice.hpp"
 #include "method/design.hpp"
+#include "method/predictors.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -52,17 +54,10 @@ std::vector<double> baselines(const std::string &text) {
 struct Candidate {
     double baseline_mm, focal_length_mm;
     std::vector<method::DesignFigures> at; // one per range of the band
-    double worst_ff_distance = 0;          // distance of the worst range's FF from the best band
+    double worst_score = 0;                // the ranking predictor at the band's worst range
     bool panel_fits = true, in_search = true;
     double eta_3d = NAN;                   // --simulate
 };
-
-// How far FF lies from the paper's best band 1.2-2.0 (0 inside), in log terms so that
-// 0.6 and 4.0 (both a factor 2 off) weigh alike.
-double ffDistance(double ff) {
-    if (ff >= 1.2 && ff <= 2.0) return 0;
-    return ff < 1.2 ? std::log(1.2 / ff) : std::log(ff / 2.0);
-}
 
 int run(const Args &args) {
     std::vector<double> ranges;
@@ -93,27 +88,45 @@ int run(const Args &args) {
         if (!(v > 0)) throw Error("--baselines: baselines must be positive mm");
     if (!(head.pixel_pitch_um > 0)) throw Error("--pixel-pitch-um must be positive");
 
+    // The predictor to rank with: the one whose Spearman rho with measured η3D is
+    // highest (by default on the simulated E1 with ten repeats; --predictor forces one).
+    const PredictorChoice choice = loadPredictorChoice(args.get("--predictors-from", dataFile("configs/predictors/e1-sim.json")));
+    std::string predictor = args.get("--predictor", choice.best);
+    const auto &names = method::predictorNames();
+    if (std::find(names.begin(), names.end(), predictor) == names.end()) {
+        std::string valid;
+        for (const auto &n : names) valid += (valid.empty() ? "" : ", ") + n;
+        throw Error("--predictor " + predictor + ": unknown (expected one of " + valid + ")");
+    }
+    std::fprintf(stderr, "design: Spearman's rho with η3D over %d tests of %s (%s):\n", choice.tests,
+                 choice.experiment.empty() ? "an experiment" : choice.experiment.c_str(), choice.file.c_str());
+    for (const auto &[name, rho] : choice.rho)
+        std::fprintf(stderr, "  %-20s %6.3f%s\n", name.c_str(), rho, name == predictor ? "   <- ranks" : "");
+    std::fprintf(stderr, "design: ranking by %s (%s)\n", predictor.c_str(),
+                 predictor == choice.best ? "the highest rho" : "chosen with --predictor");
+
     std::vector<Candidate> cands;
     for (double b : bases)
         for (double f : lenses) {
-            Candidate c{b, f, {}, 0, true, true, NAN};
+            Candidate c{b, f, {}, INFINITY, true, true, NAN};
             head.baseline_mm = b;
             head.focal_length_mm = f;
             for (double r : ranges) {
                 c.at.push_back(method::designFigures(head, r, 0.25, &panel));
                 const auto &x = c.at.back();
-                c.worst_ff_distance = std::max(c.worst_ff_distance, ffDistance(x.form_factor));
+                c.worst_score = std::min(c.worst_score, method::predictors(head, r, panel).get(predictor));
                 c.panel_fits = c.panel_fits && x.panel_fits_width;
                 c.in_search = c.in_search && (!std::isfinite(x.min_range_mm) || x.min_range_mm <= r);
             }
             cands.push_back(c);
         }
     // Rank: configurations that see the whole panel and whose search reaches the range
-    // first, then FF closest to the best band, then the finer depth resolution.
+    // first, then the predictor's score at the band's worst range, then the finer depth
+    // resolution.
     auto byFigures = [](const Candidate &a, const Candidate &b) {
         if (a.panel_fits != b.panel_fits) return a.panel_fits;
         if (a.in_search != b.in_search) return a.in_search;
-        if (std::fabs(a.worst_ff_distance - b.worst_ff_distance) > 1e-9) return a.worst_ff_distance < b.worst_ff_distance;
+        if (std::fabs(a.worst_score - b.worst_score) > 1e-9) return a.worst_score > b.worst_score;
         return a.at.back().depth_resolution_mm < b.at.back().depth_resolution_mm;
     };
     std::stable_sort(cands.begin(), cands.end(), byFigures);
@@ -180,7 +193,7 @@ int run(const Args &args) {
                                                            : method::formFactorReading(x.form_factor));
         Json j = Json::object();
         j.set("rank", static_cast<int64_t>(i + 1)).set("baseline_mm", c.baseline_mm).set("focal_length_mm", c.focal_length_mm);
-        j.set("panel_fits", c.panel_fits).set("search_reaches_range", c.in_search);
+        j.set("panel_fits", c.panel_fits).set("search_reaches_range", c.in_search).set("predictor", predictor).set("score", c.worst_score);
         if (std::isfinite(c.eta_3d)) j.set("eta_3d_percent", c.eta_3d);
         Json per = Json::array();
         for (const auto &f : c.at) {
@@ -217,9 +230,12 @@ Register reg({"design", "rank baselines and lenses for a target range or band by
               "usage: binocle design (--range MM[,MM...] | --band MIN,MAX) [options]\n\n"
               "Ranks every combination of the available baselines and lenses for the target\n"
               "range(s): configurations that see the whole test panel and whose disparity search\n"
-              "reaches the range first, then by how close the form factor FF = 10·B·f/R (Eq. 7)\n"
-              "lies to the paper's best band 1.2-2.0 (worst range of the band counts), then by\n"
-              "depth resolution. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
+              "reaches the range first, then by the predictor whose Spearman rho with measured\n"
+              "η3D is highest (it prints each rho; by default measured on the simulated E1 with\n"
+              "ten repeats, configs/predictors/e1-sim.json): form_factor (FF = 10·B·f/R, Eq. 7),\n"
+              "ff_band (closeness to the paper's best band 1.2-2.0), expected_disparity,\n"
+              "depth_resolution (-dR/R) or sensor_aware (η3D predicted from the design); the\n"
+              "band's worst range counts. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
               "depth resolution dR = R²·p·Δd/(B·f) for Δd = 0.25 px, the minimum range of the\n"
               "disparity search and whether the panel fits the stereo field.\n\n"
               "  --range 6000,12000        target range(s) in mm\n"
@@ -232,6 +248,9 @@ Register reg({"design", "rank baselines and lenses for a target range or band by
               "  --camera-height-mm 1500 --inclination-deg 0\n"
               "  --panel-width-mm 2500 --panel-height-mm 2000   the object that must fit\n"
               "  --top 10                  rows printed\n"
+              "  --predictors-from FILE    results.json whose predictors' rho chooses the ranking\n"
+              "                            (default configs/predictors/e1-sim.json)\n"
+              "  --predictor NAME          rank by this predictor instead of the best one\n"
               "  --simulate                measure η3D on the simulated rig for the best candidates\n"
               "  --simulate-count 12       how many candidates to simulate\n"
               "  --rig FILE                base rig for --simulate (default configs/rigs/sim-e1.yaml)\n"

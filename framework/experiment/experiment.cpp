@@ -36,7 +36,8 @@ const std::vector<std::string> kVariables = {"baseline_mm", "focal_length_mm", "
 const std::vector<std::string> kTopKeys = {
     "name",    "description", "rig",        "frames",     "lenses_mm",         "baseline_range_mm", "pixel_pitch_um",
     "image_width_px", "image_height_px", "disparity_search_px", "bind", "defaults", "tests", "charts", "repeats",
-    "seed",    "seeds",       "seed_path",  "jitter",     "calibration",       "board_calibration", "lens_table", "panel"};
+    "seed",    "seeds",       "seed_path",  "jitter",     "calibration",       "board_calibration", "lens_table", "panel",
+    "rig_set"};
 const std::vector<std::string> kTestKeys = {"id", "baseline_mm", "focal_length_mm", "range_mm", "camera_height_mm",
                                             "inclination_deg", "set", "repeats", "paper"};
 
@@ -237,6 +238,19 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
     } catch (const YAML::ParserException &x) {
         throw Error(e.rig_file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
                     ": YAML syntax error: " + x.msg);
+    }
+    // rig_set: a partial rig laid over the base rig for every test (variants of a whole
+    // experiment: `--set rig_set.source.image_width=640`).
+    if (YAML::Node rs = root["rig_set"]) {
+        if (!rs.IsMap()) r.fail(rs, "rig_set: expected a map, a partial rig laid over the base rig");
+        std::function<void(const YAML::Node &, const std::string &)> lay = [&](const YAML::Node &n, const std::string &path) {
+            if (n.IsMap()) {
+                for (const auto &kv : n) lay(kv.second, path + (path.empty() ? "" : ".") + kv.first.as<std::string>());
+                return;
+            }
+            applyOverride(e.rig, Override{path, yamlText(n), "rig_set: " + path});
+        };
+        lay(rs, "");
     }
     if (root["frames"]) {
         const double f = r.number(root["frames"], "frames");

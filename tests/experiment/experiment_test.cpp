@@ -319,3 +319,31 @@ TEST(ExperimentE2, LevelTestsFindTheMarkerWithinItsOwnSize) {
 }
 
 } // namespace
+
+namespace {
+
+TEST(Design, RanksWithThePredictorOfHighestRhoAndPrintsEachRho) {
+    auto r = runCli("design --range 6000 --top 3");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // The shipped rho values: the simulated E1 with ten repeats (scripts/update-predictors.sh).
+    const auto shipped = nlohmann::ordered_json::parse(readTextFile(BINOCLE_SOURCE_DIR "/configs/predictors/e1-sim.json"));
+    const std::string best = shipped["predictors"]["best"].get<std::string>();
+    for (const char *name : {"form_factor", "ff_band", "expected_disparity", "depth_resolution", "sensor_aware"})
+        EXPECT_NE(r.output.find(std::string("  ") + name), std::string::npos) << name << "\n" << r.output;
+    EXPECT_NE(r.output.find("ranking by " + best + " (the highest rho)"), std::string::npos) << r.output;
+    // Another experiment's rho chooses another predictor.
+    TempDir dir;
+    writeText(dir.str("p.json"), R"({"experiment": "x", "predictors": {"tests": 9, "spearman_rho":
+        {"form_factor": 0.2, "ff_band": 0.1, "expected_disparity": 0.2, "depth_resolution": 0.2, "sensor_aware": 0.7}}})");
+    r = runCli("design --range 12000 --top 3 --predictors-from " + dir.str("p.json"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("ranking by sensor_aware (the highest rho)"), std::string::npos) << r.output;
+    writeText(dir.str("bad.json"), R"({"predictors": {"spearman_rho": {"magic": 1}}})");
+    r = runCli("design --range 12000 --predictors-from " + dir.str("bad.json"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("unknown predictor 'magic'"), std::string::npos) << r.output;
+    r = runCli("design --range 12000 --predictor nonsense");
+    EXPECT_NE(r.output.find("--predictor nonsense: unknown"), std::string::npos) << r.output;
+}
+
+} // namespace
