@@ -35,7 +35,7 @@ def cell(r):
 print("| test | R (m) | B (mm) | f (mm) | paper | " + " | ".join(names) + " |")
 print("|---|---|---|---|---|" + "---|" * len(names))
 for i, r0 in enumerate(docs[names[0]]["tests"]):
-    paper = r0.get("paper.eta_3d_percent")
+    paper = r0.get("paper_reported.eta_3d_percent")
     print(f"| {r0['test']} | {r0['range_mm'] / 1000:g} | {r0['baseline_mm']:g} | {r0['focal_length_mm']:g} | "
           f"{'' if paper is None else paper} | " + " | ".join(cell(docs[n]["tests"][i]) for n in names) + " |")
 print()

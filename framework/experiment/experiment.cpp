@@ -932,12 +932,12 @@ Row runTest(const Experiment &e, const ExperimentTest &t, const PluginHost &host
         OJson paper = OJson::object();
         for (const auto &[k, reported] : t.paper) {
             const double measured = row.get(k);
-            row.put("paper." + k, reported);
+            row.put("paper_reported." + k, reported); // not "paper.": the paper evaluator's figures are named so
             paper[k] = {{"reported", reported},
                         {"measured", std::isfinite(measured) ? OJson(measured) : OJson()},
                         {"difference", std::isfinite(measured) ? OJson(measured - reported) : OJson()}};
         }
-        row.details["paper"] = paper;
+        row.details["paper_reported"] = paper;
     }
     return row;
 }

@@ -176,9 +176,11 @@ TEST(ExperimentRepeats, EveryFigureGetsMeanSdAndConfidenceIntervalDeterministica
     for (const char *k : {"epsilon_x_percent_sd", "epsilon_y_percent_ci95_low", "valid_pixel_ratio_ci95_high"})
         EXPECT_TRUE(row.contains(k)) << k;
     // Measured beside reported.
-    EXPECT_EQ(row["paper.eta_3d_percent"], 82);
-    EXPECT_EQ(row["paper"]["eta_3d_percent"]["reported"], 82);
-    EXPECT_NEAR(row["paper"]["eta_3d_percent"]["difference"].get<double>(), mean - 82, 1e-9);
+    EXPECT_EQ(row["paper_reported.eta_3d_percent"], 82);
+    EXPECT_EQ(row["paper_reported"]["eta_3d_percent"]["reported"], 82);
+    EXPECT_NEAR(row["paper_reported"]["eta_3d_percent"]["difference"].get<double>(), mean - 82, 1e-9);
+    // The paper evaluator's own figure of the same name is left as measured.
+    EXPECT_NEAR(row["paper.eta_3d_percent"].get<double>(), mean, 1e-9);
     // Same seeds, same figures; other seeds, other figures.
     ASSERT_EQ(runCli("experiment " + file + " --quiet --set repeats=4 --out " + dir.str("b")).exit_code, 0);
     EXPECT_EQ(withoutTimings(a)["tests"], withoutTimings(readJson(dir.str("b/results.json")))["tests"]);
