@@ -4,58 +4,55 @@
 #include "core/error.hpp"
 #include "experiment/experiment.hpp"
 
-#include <iostream>
 #include <spdlog/spdlog.h>
+
+#include <iostream>
 #include <tuple>
-#include <sstream>
 
 namespace binocle::cli {
 namespace {
 
-// `binocle experiment merge OUT DIR...`
-int merge(const Args &args) {
-    const auto &p = args.positional();
-    if (p.size() < 3) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
+struct ExperimentArgs {
+    std::string file, out, shard;
+    std::vector<std::string> tests, set;
+    bool check = false, quiet = false;
+    std::vector<std::string> merge; // `experiment merge OUT DIR...`
+};
+
+int merge(const std::vector<std::string> &p) {
+    if (p.size() < 2) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
     PluginHost host;
     host.scan();
-    const Json result = mergeExperimentResults(p[1], std::vector<std::string>(p.begin() + 2, p.end()), host);
-    const int64_t failed = static_cast<int64_t>(result.get("failed")->number());
-    spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.get("tests")->number(),
-                 p.size() - 2, failed, p[1]);
-    return failed ? 1 : 0;
+    const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host);
+    spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.rows.size(), p.size() - 1,
+                 result.failed, p[0]);
+    return result.failed ? 1 : 0;
 }
 
-int run(const Args &args) {
-    if (!args.positional().empty() && args.positional()[0] == "merge") return merge(args);
-    if (args.positional().size() != 1) throw Error("expected one experiment file: binocle experiment FILE (see --help)");
+int experiment(const ExperimentArgs &args) {
+    if (!args.merge.empty()) return merge(args.merge);
+    if (args.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
     PluginHost host;
     host.scan();
     // Everything is checked before the first test runs.
-    Experiment e = loadExperiment(args.positional()[0], host, args.all("--set"));
-    ExperimentOptions options;
-    if (args.has("--shard")) std::tie(options.shard_index, options.shard_count) = parseShard(args.get("--shard"));
-    options.out_dir = args.get("--out", "out/" + e.name);
-    options.progress = !args.has("--quiet");
-    for (const auto &list : args.all("--tests")) {
-        std::stringstream ss(list);
-        for (std::string id; std::getline(ss, id, ',');)
-            if (!id.empty()) options.only.push_back(id);
-    }
-    if (args.has("--check")) {
+    Experiment e = loadExperiment(args.file, host, args.set);
+    if (args.check) {
         std::cout << "experiment " << e.name << ": " << e.tests.size() << " tests, rig " << e.rig_file << ": valid\n";
         return 0;
     }
-    Json result = runExperiment(e, host, options);
-    const int64_t failed = static_cast<int64_t>(result.get("failed")->number());
-    std::cerr << "experiment " << e.name << ": " << result.get("tests")->number() << " test(s) in "
-              << static_cast<int>(result.get("seconds")->number()) << " s, " << failed << " failed; results in "
-              << options.out_dir << " (results.csv, results.json, charts, test_<id>/)\n";
-    return failed ? 1 : 0;
+    ExperimentOptions options;
+    options.out_dir = args.out.empty() ? "out/" + e.name : args.out;
+    options.progress = !args.quiet;
+    if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
+    for (const auto &id : args.tests)
+        if (!id.empty()) options.only.push_back(id);
+    const ExperimentResult result = runExperiment(e, host, options);
+    spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",
+                 e.name, result.rows.size(), static_cast<int>(result.seconds), result.failed, options.out_dir);
+    return result.failed ? 1 : 0;
 }
 
-Register reg({"experiment", "run an experiment (E1, E2 of METHOD.md): a table of errors and efficiencies, charts",
-              "usage: binocle experiment FILE [--out DIR] [--set KEY=VALUE]... [--tests ID,ID...] [--shard K/N] [--check] [--quiet]\n"
-              "       binocle experiment merge OUT DIR...\n\n"
+Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of errors and efficiencies, charts",
               "Runs each test of the experiment file: the base rig with the test's baseline,\n"
               "focal length, range, camera height and inclination. The whole file, and the rig\n"
               "of every test, is validated before anything runs. Writes into DIR (default\n"
@@ -69,17 +66,32 @@ Register reg({"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
               "over N renderings with their own noise seed (and jitter: when the file asks), with\n"
               "<figure>_sd and the 95 % confidence interval <figure>_ci95_low/_high; charts carry\n"
               "error bars. calibration: board calibrates every configuration from chessboard pairs\n"
-              "first. results.json holds Spearman's rho of each predictor against η3D.\n\n"
-              "  --out DIR        output folder\n"
-              "  --set KEY=VALUE  change a key of the experiment file (repeats=10, calibration=board,\n"
-              "                   board_calibration.pairs=15, seed=7); repeatable\n"
-              "  --shard K/N      run the K-th of N deterministic shares of the tests (position % N == K-1);\n"
-              "                   join the shards' folders with `binocle experiment merge OUT DIR...`\n"
-              "  --tests 1,5,9    run only these tests\n"
-              "  --check          validate the file and stop\n"
-              "  --quiet          no progress bar\n",
-              {"--check", "--quiet"},
-              run});
+              "first. results.json holds Spearman's rho of each predictor against η3D.\n"
+              "`binocle experiment merge OUT DIR...` joins the folders of --shard runs.",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<ExperimentArgs>();
+                  app.add_option("file", args->file, "the experiment file (YAML)")->type_name("FILE");
+                  app.add_option("--set", args->set,
+                                 "change a key of the experiment file (repeats=10, calibration=board, "
+                                 "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640); repeatable")
+                      ->type_name("KEY=VALUE")
+                      ->allow_extra_args(false);
+                  app.add_option("--shard", args->shard,
+                                 "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
+                                 "shards with `binocle experiment merge OUT DIR...`")
+                      ->type_name("K/N");
+                  auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
+                                                        "one unsharded run (timings apart)");
+                  m->add_option("folders", args->merge, "OUT DIR...")->required()->expected(2, -1);
+                  app.add_option("--out", args->out, "output folder (default out/<experiment name>)")->type_name("DIR");
+                  app.add_option("--tests", args->tests, "run only these tests, e.g. --tests 1,5,9")
+                      ->type_name("ID,ID...")
+                      ->delimiter(',')
+                      ->allow_extra_args(false);
+                  app.add_flag("--check", args->check, "validate the file and stop");
+                  app.add_flag("--quiet", args->quiet, "no progress display");
+                  return [args] { return experiment(*args); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

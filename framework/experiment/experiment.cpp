@@ -5,6 +5,7 @@
 #include "config/rig_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
 #include "method/statistics.hpp"
@@ -575,27 +576,6 @@ std::string csvCell(double v) {
     return buf;
 }
 
-class ProgressBar {
-public:
-    ProgressBar(bool on, size_t total) : on_(on), total_(total), tty_(::isatty(2) != 0) {}
-    void show(size_t done, const std::string &what) {
-        if (!on_) return;
-        const int width = 24;
-        const int filled = static_cast<int>(width * done / std::max<size_t>(1, total_));
-        std::string bar = "[" + std::string(filled, '#') + std::string(width - filled, '-') + "]";
-        std::cerr << (tty_ ? "\r\033[K" : "") << bar << " " << done << "/" << total_ << "  " << what << (tty_ ? "" : "\n")
-                  << std::flush;
-    }
-    ~ProgressBar() {
-        if (on_ && tty_) std::cerr << "\n";
-    }
-
-private:
-    bool on_;
-    size_t total_;
-    bool tty_;
-};
-
 std::string testLabel(const ExperimentTest &t) {
     std::ostringstream os;
     os << "test " << t.id << " (R " << t.geometry.range_mm / 1000 << " m, B " << t.geometry.baseline_mm << " mm, f "
@@ -942,6 +922,21 @@ Row runTest(const Experiment &e, const ExperimentTest &t, const PluginHost &host
     return row;
 }
 
+ExperimentResult resultOf(const std::vector<Row> &rows) {
+    ExperimentResult result;
+    for (const auto &r : rows) {
+        ExperimentRow out;
+        out.test_id = r.test->id;
+        out.geometry = r.test->geometry;
+        out.status = r.status;
+        out.error = r.error;
+        out.values = r.values;
+        result.rows.push_back(std::move(out));
+    }
+    result.failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
+    return result;
+}
+
 TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount) {
     TablesMeta m;
     for (const auto &t : e.tests) m.test_ids.push_back(t.id);
@@ -951,6 +946,21 @@ TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount) {
 }
 
 } // namespace
+
+double ExperimentRow::get(const std::string &column) const {
+    for (const auto &[n, v] : values)
+        if (n == column) return v;
+    return NAN;
+}
+
+void ExperimentRow::put(const std::string &column, double value) {
+    for (auto &[n, x] : values)
+        if (n == column) {
+            x = value;
+            return;
+        }
+    values.emplace_back(column, value);
+}
 
 std::pair<int, int> parseShard(const std::string &text) {
     const auto slash = text.find('/');
@@ -968,7 +978,7 @@ std::pair<int, int> parseShard(const std::string &text) {
     return {k, n};
 }
 
-Json runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
+ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
     if (options.out_dir.empty()) throw Error("experiment: an output folder is needed (--out DIR)");
     if (options.shard_count < 1 || options.shard_index < 1 || options.shard_index > options.shard_count)
         throw Error("experiment: shard " + std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count) +
@@ -988,11 +998,11 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
     const TablesMeta meta = metaOf(e, options.shard_index, options.shard_count);
 
     std::vector<Row> rows;
-    ProgressBar bar(options.progress, selected.size());
+    Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
     const auto start = std::chrono::steady_clock::now();
     for (size_t i = 0; i < selected.size(); ++i) {
         const ExperimentTest &t = *selected[i];
-        bar.show(i, testLabel(t));
+        progress.update(static_cast<int64_t>(i), testLabel(t));
         const auto t0 = std::chrono::steady_clock::now();
         Row row = runTest(e, t, host, options.out_dir);
         row.put("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -1001,18 +1011,15 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
         writeTables(options.out_dir, e, rows, meta);
     }
     if (rows.empty()) writeTables(options.out_dir, e, rows, meta); // an empty shard still says so
-    bar.show(selected.size(), "done");
+    progress.update(static_cast<int64_t>(selected.size()), "done");
+    progress.finish();
     writeCharts(options.out_dir, e, rows);
-    Json result = Json::object();
-    result.set("experiment", e.name);
-    result.set("tests", static_cast<int64_t>(rows.size()));
-    const auto failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
-    result.set("failed", static_cast<int64_t>(failed));
-    result.set("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ExperimentResult result = resultOf(rows);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
 
-Json mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host) {
+ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host) {
     if (dirs.empty()) throw Error("experiment merge: no folder to merge (binocle experiment merge OUT DIR...)");
     std::vector<OJson> docs;
     for (const auto &d : dirs) {
@@ -1077,12 +1084,7 @@ Json mergeExperimentResults(const std::string &out_dir, const std::vector<std::s
         }
     writeTables(out_dir, e, rows, metaOf(e, 1, 1));
     writeCharts(out_dir, e, rows);
-    Json result = Json::object();
-    result.set("experiment", e.name);
-    result.set("tests", static_cast<int64_t>(rows.size()));
-    const auto failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
-    result.set("failed", static_cast<int64_t>(failed));
-    return result;
+    return resultOf(rows);
 }
 
 } // namespace binocle

@@ -121,6 +121,25 @@ struct ExperimentOptions {
     int shard_index = 1, shard_count = 1; // --shard K/N: the tests whose position p (0-based, file order) has p % N == K - 1
 };
 
+// One row of results.csv / results.json: a test's variables and every figure measured.
+struct ExperimentRow {
+    std::string test_id;
+    TestGeometry geometry;
+    std::string status = "ok"; // or "failed", with `error`
+    std::string error;
+    std::vector<std::pair<std::string, double>> values; // column -> value, in column order (NaN: none)
+
+    // NaN when the column is absent.
+    double get(const std::string &column) const;
+    void put(const std::string &column, double value);
+};
+
+struct ExperimentResult {
+    std::vector<ExperimentRow> rows; // one per test run, in order
+    int64_t failed = 0;
+    double seconds = 0;
+};
+
 // "K/N" -> (K, N), 1 <= K <= N; throws binocle::Error naming the option and the value.
 std::pair<int, int> parseShard(const std::string &text);
 
@@ -128,12 +147,12 @@ std::pair<int, int> parseShard(const std::string &text);
 // `out_dir`: the rows in the experiment's test order, the predictors' rho and the charts
 // recomputed over all of them, each test's folder copied. Throws when two folders hold
 // the same test, when they come from different experiments, or when a test is missing.
-Json mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host);
+ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host);
 
 // Runs every test and writes results.csv, results.json, charts and per-test outputs
-// into out_dir/test_<id>/. Returns the results (also in results.json). A test whose
-// pipeline fails is recorded with its error and the others still run; the caller
-// decides the exit status from "failed" in the result.
-Json runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options);
+// into out_dir/test_<id>/. Returns the rows it wrote. A test whose pipeline fails is
+// recorded with its error and the others still run; the caller decides the exit status
+// from `failed`.
+ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options);
 
 } // namespace binocle
