@@ -8,7 +8,9 @@
 #include "core/error.hpp"
 #include "core/json.hpp"
 #include "experiment/experiment.hpp"
+#include "experiment/predictor_choice.hpp"
 #include "method/design.hpp"
+#include "method/predictors.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,6 +32,7 @@ struct DesignArgs {
     int top = 10, simulate_count = 12;
     bool simulate = false, quiet = false;
     std::string rig, out;
+    std::string predictors_from, predictor; // empty: the shipped file; the best of it
 };
 
 std::vector<double> numberList(const std::string &option, const std::string &text) {
@@ -62,7 +65,7 @@ std::vector<double> baselines(const std::string &text) {
 struct Candidate {
     double baseline_mm, focal_length_mm;
     std::vector<method::DesignFigures> at; // one per range of the band
-    double worst_ff_distance = 0;          // distance of the worst range's FF from the best band
+    double worst_score = 0;                // the ranking predictor at the band's worst range
     bool panel_fits = true, in_search = true;
     double eta_3d = NAN;                   // --simulate
 };
@@ -95,27 +98,44 @@ int design(const DesignArgs &args) {
     for (double v : bases)
         if (!(v > 0)) throw UsageError("--baselines: baselines must be positive mm");
 
+    // The predictor to rank with: the one whose Spearman rho with measured η3D is
+    // highest (by default on the simulated E1 with ten repeats; --predictor forces one).
+    const PredictorChoice choice = loadPredictorChoice(args.predictors_from.empty() ? dataFile("configs/predictors/e1-sim.json") : args.predictors_from);
+    const std::string predictor = args.predictor.empty() ? choice.best : args.predictor;
+    const auto &names = method::predictorNames();
+    if (std::find(names.begin(), names.end(), predictor) == names.end()) {
+        std::string valid;
+        for (const auto &n : names) valid += (valid.empty() ? "" : ", ") + n;
+        throw UsageError("--predictor " + predictor + ": unknown (expected one of " + valid + ")");
+    }
+    spdlog::info("design: Spearman's rho with η3D over {} tests of {} ({}):", choice.tests,
+                 choice.experiment.empty() ? "an experiment" : choice.experiment, choice.file);
+    for (const auto &[name, rho] : choice.rho)
+        spdlog::info("  {:<20} {:6.3f}{}", name, rho, name == predictor ? "   <- ranks" : "");
+    spdlog::info("design: ranking by {} ({})", predictor, predictor == choice.best ? "the highest rho" : "chosen with --predictor");
+
     std::vector<Candidate> cands;
     for (double b : bases)
         for (double f : lenses) {
-            Candidate c{b, f, {}, 0, true, true, NAN};
+            Candidate c{b, f, {}, INFINITY, true, true, NAN};
             head.baseline_mm = b;
             head.focal_length_mm = f;
             for (double r : ranges) {
                 c.at.push_back(method::designFigures(head, r, 0.25, &panel));
                 const auto &x = c.at.back();
-                c.worst_ff_distance = std::max(c.worst_ff_distance, method::formFactorBandDistance(x.form_factor));
+                c.worst_score = std::min(c.worst_score, method::predictors(head, r, panel).get(predictor));
                 c.panel_fits = c.panel_fits && x.panel_fits_width;
                 c.in_search = c.in_search && (!std::isfinite(x.min_range_mm) || x.min_range_mm <= r);
             }
             cands.push_back(c);
         }
     // Rank: configurations that see the whole panel and whose search reaches the range
-    // first, then FF closest to the best band, then the finer depth resolution.
+    // first, then the predictor's score at the band's worst range, then the finer depth
+    // resolution.
     auto byFigures = [](const Candidate &a, const Candidate &b) {
         if (a.panel_fits != b.panel_fits) return a.panel_fits;
         if (a.in_search != b.in_search) return a.in_search;
-        if (std::fabs(a.worst_ff_distance - b.worst_ff_distance) > 1e-9) return a.worst_ff_distance < b.worst_ff_distance;
+        if (std::fabs(a.worst_score - b.worst_score) > 1e-9) return a.worst_score > b.worst_score;
         return a.at.back().depth_resolution_mm < b.at.back().depth_resolution_mm;
     };
     std::stable_sort(cands.begin(), cands.end(), byFigures);
@@ -171,7 +191,9 @@ int design(const DesignArgs &args) {
                   {"baseline_mm", c.baseline_mm},
                   {"focal_length_mm", c.focal_length_mm},
                   {"panel_fits", c.panel_fits},
-                  {"search_reaches_range", c.in_search}};
+                  {"search_reaches_range", c.in_search},
+                  {"predictor", predictor},
+                  {"score", c.worst_score}};
         if (std::isfinite(c.eta_3d)) j["eta_3d_percent"] = c.eta_3d;
         Json per = Json::array();
         for (const auto &f : c.at) {
@@ -206,9 +228,12 @@ int design(const DesignArgs &args) {
 Register reg{{"design", "rank baselines and lenses for a target range or band by FF (Eq. 7), or by simulated η3D",
               "Ranks every combination of the available baselines and lenses for the target\n"
               "range(s): configurations that see the whole test panel and whose disparity search\n"
-              "reaches the range first, then by how close the form factor FF = 10·B·f/R (Eq. 7)\n"
-              "lies to the paper's best band (1.2-2.0, METHOD.md; the worst range of the band counts), then by\n"
-              "depth resolution. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
+              "reaches the range first, then by the predictor whose Spearman rho with measured\n"
+              "η3D is highest (it prints each rho; by default measured on the simulated E1 with\n"
+              "ten repeats, configs/predictors/e1-sim.json): form_factor (FF = 10·B·f/R, Eq. 7),\n"
+              "ff_band (closeness to the paper's best band 1.2-2.0), expected_disparity,\n"
+              "depth_resolution (-dR/R) or sensor_aware (η3D predicted from the design); the\n"
+              "band's worst range counts. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
               "depth resolution dR = R²·p·Δd/(B·f) for Δd = 0.25 px, the minimum range of the\n"
               "disparity search and whether the panel fits the stereo field.\n"
               "One of --range or --band is required.",
@@ -238,6 +263,11 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
                       ->type_name("MM")
                       ->check(positiveNumber());
                   app.add_option("--top", a->top, "rows printed (default 10)")->type_name("N")->check(atLeast(1));
+                  app.add_option("--predictors-from", a->predictors_from,
+                                 "results.json whose predictors' rho chooses the ranking (default configs/predictors/e1-sim.json)")
+                      ->type_name("FILE");
+                  app.add_option("--predictor", a->predictor, "rank by this predictor instead of the one of highest rho")
+                      ->type_name("NAME");
                   app.add_flag("--simulate", a->simulate, "measure η3D on the simulated rig for the best candidates");
                   app.add_option("--simulate-count", a->simulate_count, "how many candidates to simulate (default 12)")
                       ->type_name("N")

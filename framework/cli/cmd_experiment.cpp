@@ -1,26 +1,41 @@
 // SPDX-License-Identifier: MIT
 // `binocle experiment FILE`: runs the tests of an experiment (METHOD.md E1, E2).
 #include "cli/command.hpp"
+#include "core/error.hpp"
 #include "experiment/experiment.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <tuple>
 
 namespace binocle::cli {
 namespace {
 
 struct ExperimentArgs {
-    std::string file, out;
-    std::vector<std::string> tests;
+    std::string file, out, shard;
+    std::vector<std::string> tests, set;
     bool check = false, quiet = false;
+    std::vector<std::string> merge; // `experiment merge OUT DIR...`
 };
 
+int merge(const std::vector<std::string> &p) {
+    if (p.size() < 2) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
+    PluginHost host;
+    host.scan();
+    const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host);
+    spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.rows.size(), p.size() - 1,
+                 result.failed, p[0]);
+    return result.failed ? 1 : 0;
+}
+
 int experiment(const ExperimentArgs &args) {
+    if (!args.merge.empty()) return merge(args.merge);
+    if (args.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
     PluginHost host;
     host.scan();
     // Everything is checked before the first test runs.
-    Experiment e = loadExperiment(args.file, host);
+    Experiment e = loadExperiment(args.file, host, args.set);
     if (args.check) {
         std::cout << "experiment " << e.name << ": " << e.tests.size() << " tests, rig " << e.rig_file << ": valid\n";
         return 0;
@@ -28,6 +43,7 @@ int experiment(const ExperimentArgs &args) {
     ExperimentOptions options;
     options.out_dir = args.out.empty() ? "out/" + e.name : args.out;
     options.progress = !args.quiet;
+    if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
     for (const auto &id : args.tests)
         if (!id.empty()) options.only.push_back(id);
     const ExperimentResult result = runExperiment(e, host, options);
@@ -45,10 +61,28 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
               "                              valid-pixel ratio, time, and every evaluator figure\n"
               "  eta_3d_bars.png/.svg, eta_2d_bars.png/.svg, eta_3d_vs_ff.png/.svg   charts\n"
               "  test_<id>/                  disparity, PLY cloud, density views, summary.json\n"
-              "The tables are rewritten after every test, so an interrupted run keeps its results.",
+              "The tables are rewritten after every test, so an interrupted run keeps its results.\n\n"
+              "With repeats (repeats: N in the file, or --set repeats=N) every figure is the mean\n"
+              "over N renderings with their own noise seed (and jitter: when the file asks), with\n"
+              "<figure>_sd and the 95 % confidence interval <figure>_ci95_low/_high; charts carry\n"
+              "error bars. calibration: board calibrates every configuration from chessboard pairs\n"
+              "first. results.json holds Spearman's rho of each predictor against η3D.\n"
+              "`binocle experiment merge OUT DIR...` joins the folders of --shard runs.",
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<ExperimentArgs>();
-                  app.add_option("file", args->file, "the experiment file (YAML)")->type_name("FILE")->required();
+                  app.add_option("file", args->file, "the experiment file (YAML)")->type_name("FILE");
+                  app.add_option("--set", args->set,
+                                 "change a key of the experiment file (repeats=10, calibration=board, "
+                                 "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640); repeatable")
+                      ->type_name("KEY=VALUE")
+                      ->allow_extra_args(false);
+                  app.add_option("--shard", args->shard,
+                                 "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
+                                 "shards with `binocle experiment merge OUT DIR...`")
+                      ->type_name("K/N");
+                  auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
+                                                        "one unsharded run (timings apart)");
+                  m->add_option("folders", args->merge, "OUT DIR...")->required()->expected(2, -1);
                   app.add_option("--out", args->out, "output folder (default out/<experiment name>)")->type_name("DIR");
                   app.add_option("--tests", args->tests, "run only these tests, e.g. --tests 1,5,9")
                       ->type_name("ID,ID...")

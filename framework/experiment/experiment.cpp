@@ -5,9 +5,10 @@
 #include "config/rig_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "core/json.hpp"
 #include "core/progress.hpp"
 #include "method/design.hpp"
+#include "method/predictors.hpp"
+#include "method/statistics.hpp"
 #include "pipeline/pipeline.hpp"
 #include "report/chart.hpp"
 
@@ -15,8 +16,14 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <random>
 #include <set>
 #include <sstream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 namespace fs = std::filesystem;
@@ -27,10 +34,13 @@ namespace {
 
 const std::vector<std::string> kVariables = {"baseline_mm", "focal_length_mm", "range_mm", "camera_height_mm",
                                              "inclination_deg"};
-const std::vector<std::string> kTopKeys = {"name",     "description", "rig",   "frames", "lenses_mm", "baseline_range_mm",
-                                           "pixel_pitch_um", "image_width_px", "bind", "defaults", "tests",   "charts"};
+const std::vector<std::string> kTopKeys = {
+    "name",    "description", "rig",        "frames",     "lenses_mm",         "baseline_range_mm", "pixel_pitch_um",
+    "image_width_px", "image_height_px", "disparity_search_px", "bind", "defaults", "tests", "charts", "repeats",
+    "seed",    "seeds",       "seed_path",  "jitter",     "calibration",       "board_calibration", "lens_table", "panel",
+    "rig_set"};
 const std::vector<std::string> kTestKeys = {"id", "baseline_mm", "focal_length_mm", "range_mm", "camera_height_mm",
-                                            "inclination_deg", "set"};
+                                            "inclination_deg", "set", "repeats", "paper"};
 
 std::string join(const std::vector<std::string> &v) {
     std::string s;
@@ -178,10 +188,49 @@ std::string yamlText(const YAML::Node &n) {
     return em.c_str();
 }
 
+// The node at a dotted rig path ("source.range_mm", "transforms.0.inclination_deg"), or
+// an undefined node.
+YAML::Node nodeAt(const YAML::Node &root, const std::string &path) {
+    YAML::Node n = YAML::Clone(root);
+    std::stringstream ss(path);
+    for (std::string part; std::getline(ss, part, '.');) {
+        if (!n.IsDefined() || n.IsNull() || n.IsScalar()) return YAML::Node(YAML::NodeType::Undefined);
+        if (n.IsSequence()) {
+            if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos) return YAML::Node(YAML::NodeType::Undefined);
+            n = n[std::stoul(part)];
+        } else {
+            n = n[part];
+        }
+    }
+    return n;
+}
+
+// Uniform in [-1, 1) from a seed and a stream number, the same on every platform
+// (std::uniform_real_distribution is not specified bit for bit).
+double jitterUnit(uint32_t seed, uint32_t stream) {
+    std::seed_seq seq{seed, stream, 0x6a177e2u};
+    std::mt19937 gen(seq);
+    return static_cast<double>(gen()) / 2147483648.0 - 1.0;
+}
+
+const Lens *lensFor(const Experiment &e, double focal_length_mm) {
+    for (const auto &l : e.lens_table)
+        if (std::fabs(l.focal_length_mm - focal_length_mm) < 1e-6) return &l;
+    return nullptr;
+}
+
 } // namespace
 
-YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t) {
+uint32_t Experiment::seedOf(int repeat) const {
+    if (!seeds.empty()) return seeds.at(static_cast<size_t>(repeat));
+    return seed + static_cast<uint32_t>(repeat);
+}
+
+YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t, int repeat) {
     YAML::Node rig = YAML::Clone(e.rig);
+    if (const Lens *lens = lensFor(e, t.geometry.focal_length_mm))
+        for (const auto &[path, value] : lens->set)
+            applyOverride(rig, Override{path, value, "lens table " + e.lens_table_file + ": f = " + num(lens->focal_length_mm) + ": " + path});
     TestGeometry g = t.geometry;
     for (const auto &[var, paths] : e.bind) {
         const double *v = field(g, var);
@@ -189,13 +238,28 @@ YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t) {
         for (const auto &p : paths) applyOverride(rig, Override{p, num(*v), "test " + t.id + ": " + p + "=" + num(*v)});
     }
     for (const auto &[path, value] : t.set) applyOverride(rig, Override{path, value, "test " + t.id + ": set " + path});
+    const bool repeating = e.repeatsOf(t) > 1 || !e.seeds.empty();
+    if (repeat >= 0 && repeating) {
+        const uint32_t seed = e.seedOf(repeat);
+        applyOverride(rig, Override{e.seed_path, std::to_string(seed), "repeat " + std::to_string(repeat) + ": " + e.seed_path});
+        for (size_t k = 0; k < e.jitter.size(); ++k) {
+            const auto &[path, halfWidth] = e.jitter[k];
+            const YAML::Node n = nodeAt(rig, path);
+            double nominal = 0;
+            if (!n.IsDefined() || !n.IsScalar() || !YAML::convert<double>::decode(n, nominal))
+                throw Error(e.file + ": jitter: " + path + ": the rig of test " + t.id + " has no number there");
+            const double v = nominal + halfWidth * jitterUnit(seed, static_cast<uint32_t>(k));
+            applyOverride(rig, Override{path, num(v), "repeat " + std::to_string(repeat) + ": jitter " + path});
+        }
+    }
     return rig;
 }
 
-Experiment loadExperiment(const std::string &file, const PluginHost &host) {
+Experiment loadExperiment(const std::string &file, const PluginHost &host, const std::vector<std::string> &overrides) {
     std::error_code ec;
     Experiment e;
     e.file = fs::absolute(file, ec).lexically_normal().string();
+    e.overrides = overrides;
     if (!fs::exists(e.file)) throw Error("experiment file " + file + " does not exist");
     Reader r{e.file};
     YAML::Node root;
@@ -206,6 +270,16 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
                     ": YAML syntax error: " + x.msg);
     }
     if (!root.IsMap()) throw Error(e.file + ": expected a map with rig:, tests: ...");
+    for (const auto &text : overrides) {
+        const Override o = Override::parse(text);
+        const std::string top = o.path.substr(0, o.path.find('.'));
+        if (std::find(kTopKeys.begin(), kTopKeys.end(), top) == kTopKeys.end()) {
+            const std::string hint = nearest(top, kTopKeys);
+            throw Error("--set " + text + ": the experiment has no key '" + top + "'" +
+                        (hint.empty() ? "" : "; did you mean '" + hint + "'?") + " (valid keys: " + join(kTopKeys) + ")");
+        }
+        applyOverride(root, o);
+    }
     r.checkKeys(root, kTopKeys, "experiment");
     e.name = root["name"] ? root["name"].as<std::string>() : fs::path(e.file).stem().string();
     e.description = root["description"] ? root["description"].as<std::string>() : "";
@@ -219,6 +293,19 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
     } catch (const YAML::ParserException &x) {
         throw Error(e.rig_file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
                     ": YAML syntax error: " + x.msg);
+    }
+    // rig_set: a partial rig laid over the base rig for every test (variants of a whole
+    // experiment: `--set rig_set.source.image_width=640`).
+    if (YAML::Node rs = root["rig_set"]) {
+        if (!rs.IsMap()) r.fail(rs, "rig_set: expected a map, a partial rig laid over the base rig");
+        std::function<void(const YAML::Node &, const std::string &)> lay = [&](const YAML::Node &n, const std::string &path) {
+            if (n.IsMap()) {
+                for (const auto &kv : n) lay(kv.second, path + (path.empty() ? "" : ".") + kv.first.as<std::string>());
+                return;
+            }
+            applyOverride(e.rig, Override{path, yamlText(n), "rig_set: " + path});
+        };
+        lay(rs, "");
     }
     if (root["frames"]) {
         const double f = r.number(root["frames"], "frames");
@@ -238,6 +325,109 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
                                               : sourceFigure(e.rig, "pixel_pitch_um", host);
     e.image_width_px = static_cast<int>(root["image_width_px"] ? r.number(root["image_width_px"], "image_width_px")
                                                                : sourceFigure(e.rig, "image_width", host));
+
+    if (root["image_height_px"]) e.image_height_px = static_cast<int>(r.number(root["image_height_px"], "image_height_px"));
+    else if (e.rig["source"] && e.rig["source"]["image_height"]) e.image_height_px = e.rig["source"]["image_height"].as<int>();
+    if (YAML::Node d = root["disparity_search_px"]) {
+        auto v = r.numbers(d, "disparity_search_px");
+        if (v.size() != 2 || !(v[1] >= 1)) r.fail(d, "disparity_search_px: expected [min_disparity, num_disparities] of the matcher, e.g. [0, 64]");
+        e.min_disparity_px = static_cast<int>(v[0]);
+        e.num_disparities = static_cast<int>(v[1]);
+    }
+    if (YAML::Node p = root["panel"]) {
+        if (!p.IsMap()) r.fail(p, "panel: expected {width_mm, height_mm, center_x_mm, base_z_mm}");
+        r.checkKeys(p, {"width_mm", "height_mm", "center_x_mm", "base_z_mm"}, "panel");
+        if (p["width_mm"]) e.panel.width_mm = r.number(p["width_mm"], "panel.width_mm");
+        if (p["height_mm"]) e.panel.height_mm = r.number(p["height_mm"], "panel.height_mm");
+        if (p["center_x_mm"]) e.panel.center_x_mm = r.number(p["center_x_mm"], "panel.center_x_mm");
+        if (p["base_z_mm"]) e.panel.base_z_mm = r.number(p["base_z_mm"], "panel.base_z_mm");
+        if (!(e.panel.width_mm > 0) || !(e.panel.height_mm > 0)) r.fail(p, "panel: width_mm and height_mm must be > 0");
+    }
+
+    // Repeats, seeds, jitter.
+    auto wholeNumber = [&](const YAML::Node &n, const std::string &what, double lo, double hi) {
+        const double v = r.number(n, what);
+        if (v < lo || v > hi || v != std::floor(v))
+            r.fail(n, what + " = " + num(v) + ": expected a whole number " + num(lo) + " .. " + num(hi));
+        return v;
+    };
+    if (root["repeats"]) e.repeats = static_cast<int>(wholeNumber(root["repeats"], "repeats", 1, 10000));
+    if (root["seed"]) e.seed = static_cast<uint32_t>(wholeNumber(root["seed"], "seed", 0, 4294967295.0));
+    if (YAML::Node sl = root["seeds"]) {
+        if (!sl.IsSequence()) r.fail(sl, "seeds: expected a list of whole numbers, one per repeat");
+        for (const auto &x : sl) e.seeds.push_back(static_cast<uint32_t>(wholeNumber(x, "seeds", 0, 4294967295.0)));
+    }
+    if (root["seed_path"]) e.seed_path = root["seed_path"].as<std::string>();
+    if (YAML::Node j = root["jitter"]) {
+        if (!j.IsMap()) r.fail(j, "jitter: expected a map rig path -> half width (e.g. source.range_mm: 50)");
+        for (const auto &kv : j) {
+            const std::string path = kv.first.as<std::string>();
+            const double w = r.number(kv.second, "jitter." + path);
+            if (w < 0) r.fail(kv.second, "jitter." + path + " = " + num(w) + ": expected a half width >= 0");
+            e.jitter.emplace_back(path, w);
+        }
+    }
+
+    // Calibration per configuration.
+    if (YAML::Node c = root["calibration"]) {
+        e.calibration = c.as<std::string>();
+        if (e.calibration != "exact" && e.calibration != "board")
+            r.fail(c, "calibration: '" + e.calibration + "': expected exact (the source's own) or board (calibrated per test)");
+    }
+    if (YAML::Node b = root["board_calibration"]) {
+        if (!b.IsMap()) r.fail(b, "board_calibration: expected {pairs, board, square_mm, capture}");
+        r.checkKeys(b, {"pairs", "board", "square_mm", "capture", "max_frames"}, "board_calibration");
+        auto &spec = e.board_calibration;
+        if (b["pairs"]) spec.pairs = static_cast<int>(wholeNumber(b["pairs"], "board_calibration.pairs", 4, 1000));
+        if (b["max_frames"]) spec.max_frames = static_cast<int>(wholeNumber(b["max_frames"], "board_calibration.max_frames", 1, 100000));
+        const std::string board = b["board"] ? b["board"].as<std::string>() : "9x6";
+        const double square = b["square_mm"] ? r.number(b["square_mm"], "board_calibration.square_mm") : 25.0;
+        try {
+            spec.board = BoardSpec::parse(board, square);
+        } catch (const Error &x) {
+            r.fail(b, std::string("board_calibration: ") + x.what());
+        }
+        if (YAML::Node cap = b["capture"]) {
+            if (!cap.IsMap()) r.fail(cap, "board_calibration.capture: expected a map of rig paths to values");
+            for (const auto &kv : cap) spec.capture.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+        }
+    }
+    if (e.calibration == "board" && e.board_calibration.capture.empty())
+        r.fail(root["calibration"], "calibration: board needs board_calibration.capture: the rig settings that make the "
+                                    "source show a chessboard (see configs/experiments/e1.yaml)");
+
+    // The lens table: focal length -> rig overrides of that lens.
+    if (YAML::Node lt = root["lens_table"]) {
+        fs::path lp = lt.as<std::string>();
+        if (lp.is_relative()) lp = fs::path(e.file).parent_path() / lp;
+        e.lens_table_file = lp.lexically_normal().string();
+        if (!fs::exists(e.lens_table_file)) r.fail(lt, "lens_table: file '" + e.lens_table_file + "' does not exist");
+        YAML::Node table;
+        try {
+            table = YAML::LoadFile(e.lens_table_file);
+        } catch (const YAML::ParserException &x) {
+            throw Error(e.lens_table_file + ":" + std::to_string(x.mark.line + 1) + ": YAML syntax error: " + x.msg);
+        }
+        Reader lr{e.lens_table_file};
+        if (!table.IsMap() || !table["lenses"] || !table["lenses"].IsSequence())
+            throw Error(e.lens_table_file + ": expected a map with lenses: [{focal_length_mm, set: {rig path: value}}]");
+        lr.checkKeys(table, {"name", "description", "lenses"}, "lens table");
+        for (const auto &ln : table["lenses"]) {
+            lr.checkKeys(ln, {"focal_length_mm", "set", "note"}, "lenses");
+            Lens l;
+            if (!ln["focal_length_mm"]) lr.fail(ln, "lenses: missing key 'focal_length_mm'");
+            l.focal_length_mm = lr.number(ln["focal_length_mm"], "lenses.focal_length_mm");
+            if (!(l.focal_length_mm > 0)) lr.fail(ln["focal_length_mm"], "lenses.focal_length_mm: expected > 0");
+            if (lensFor(e, l.focal_length_mm)) lr.fail(ln, "lenses: focal length " + num(l.focal_length_mm) + " mm listed twice");
+            if (YAML::Node st = ln["set"]) {
+                if (!st.IsMap()) lr.fail(st, "lenses.set: expected a map of rig paths to values");
+                for (const auto &kv : st) l.set.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+            }
+            e.lens_table.push_back(std::move(l));
+        }
+        if (!root["lenses_mm"])
+            for (const auto &l : e.lens_table) e.lenses_mm.push_back(l.focal_length_mm);
+    }
 
     e.bind = defaultBind(e.rig, host);
     if (YAML::Node b = root["bind"]) {
@@ -306,10 +496,21 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
             if (!s.IsMap()) r.fail(s, "test " + t.id + ": set: expected a map of rig paths to values");
             for (const auto &kv : s) t.set.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
         }
+        if (tn["repeats"]) t.repeats = static_cast<int>(wholeNumber(tn["repeats"], "test " + t.id + ": repeats", 1, 10000));
+        if (YAML::Node pp = tn["paper"]) {
+            if (!pp.IsMap()) r.fail(pp, "test " + t.id + ": paper: expected a map figure -> value the paper reported");
+            for (const auto &kv : pp) t.paper.emplace_back(kv.first.as<std::string>(), r.number(kv.second, "test " + t.id + ": paper." + kv.first.as<std::string>()));
+        }
+        if (!e.seeds.empty() && static_cast<int>(e.seeds.size()) < e.repeatsOf(t))
+            r.fail(root["seeds"], "seeds: " + std::to_string(e.seeds.size()) + " seeds for " + std::to_string(e.repeatsOf(t)) +
+                                      " repeats of test " + t.id + ": give one seed per repeat");
+        if (!e.lens_table.empty() && !lensFor(e, t.geometry.focal_length_mm))
+            r.fail(tn, "test " + t.id + ": focal_length_mm = " + num(t.geometry.focal_length_mm) + ": not in the lens table " +
+                           e.lens_table_file);
         checkGeometry(e, t, r, tn);
         // The whole rig of this test must be valid before anything runs.
         try {
-            rigFromNode(rigForTest(e, t), e.rig_file, host);
+            rigFromNode(rigForTest(e, t, 0), e.rig_file, host);
         } catch (const Error &x) {
             r.fail(tn, "test " + t.id + ": its rig is invalid: " + x.what());
         }
@@ -368,12 +569,60 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
 
 namespace {
 
+using OJson = nlohmann::ordered_json;
+
 // Main columns first (the names of METHOD.md), then every other figure an evaluator
 // reported, as "<evaluator>.<metric>".
 const std::vector<std::string> kMainMetrics = {"epsilon_x_percent", "epsilon_y_percent", "epsilon_z_percent",
                                                "eta_2d_percent", "eta_3d_percent"};
+// The figures summarised over repeats (mean, sd, 95 % CI).
+const std::vector<std::string> kRepeatedMetrics = {"epsilon_x_percent", "epsilon_y_percent", "epsilon_z_percent",
+                                                   "eta_2d_percent",    "eta_3d_percent",    "valid_pixel_ratio"};
+// Row keys that are not numbers.
+const std::vector<std::string> kRowTextKeys = {"test", "status", "error"};
 
-using Row = ExperimentRow;
+struct Row {
+    const ExperimentTest *test = nullptr;
+    std::vector<std::pair<std::string, double>> values; // in column order
+    std::string status = "ok", error;
+    OJson details = OJson::object(); // repeats, calibration, paper: results.json only
+    double get(const std::string &k) const {
+        for (const auto &[n, v] : values)
+            if (n == k) return v;
+        return NAN;
+    }
+    void put(const std::string &k, double v) {
+        for (auto &[n, x] : values)
+            if (n == k) {
+                x = v;
+                return;
+            }
+        values.emplace_back(k, v);
+    }
+    OJson toJson() const {
+        OJson row = OJson::object();
+        row["test"] = test->id;
+        row["status"] = status;
+        for (const auto &[n, v] : values) row[n] = std::isfinite(v) ? OJson(v) : OJson();
+        if (!error.empty()) row["error"] = error;
+        for (const auto &[k, v] : details.items()) row[k] = v;
+        return row;
+    }
+    // From a results.json row (merge): numbers and nulls are values, objects details.
+    static Row fromJson(const OJson &j, const ExperimentTest *t) {
+        Row r;
+        r.test = t;
+        r.status = j.value("status", "ok");
+        r.error = j.value("error", "");
+        for (const auto &[k, v] : j.items()) {
+            if (std::find(kRowTextKeys.begin(), kRowTextKeys.end(), k) != kRowTextKeys.end()) continue;
+            if (v.is_number()) r.values.emplace_back(k, v.get<double>());
+            else if (v.is_null()) r.values.emplace_back(k, NAN);
+            else r.details[k] = v;
+        }
+        return r;
+    }
+};
 
 std::string csvCell(double v) {
     if (!std::isfinite(v)) return "";
@@ -390,7 +639,49 @@ std::string testLabel(const ExperimentTest &t) {
     return os.str() + ")";
 }
 
-void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows) {
+// Spearman's rho between each predictor (a row column) and η3D over the rows that
+// measured it; the best is the one with the highest rho.
+OJson predictorRho(const std::vector<Row> &rows) {
+    static const std::vector<std::pair<std::string, std::string>> kColumns = {
+        {"form_factor", "form_factor"},
+        {"ff_band", "predictor.ff_band"},
+        {"expected_disparity", "expected_disparity_px"},
+        {"depth_resolution", "predictor.depth_resolution"},
+        {"sensor_aware", "predictor.sensor_aware"}};
+    std::vector<double> eta;
+    for (const auto &r : rows) eta.push_back(r.status == "ok" ? r.get("eta_3d_percent") : NAN);
+    OJson rho = OJson::object();
+    std::string best;
+    double bestRho = -2;
+    int n = 0;
+    for (double v : eta) n += std::isfinite(v) ? 1 : 0;
+    for (const auto &[name, column] : kColumns) {
+        std::vector<double> x;
+        for (const auto &r : rows) x.push_back(r.get(column));
+        const double value = method::spearman(x, eta);
+        rho[name] = std::isfinite(value) ? OJson(value) : OJson();
+        if (std::isfinite(value) && value > bestRho) {
+            bestRho = value;
+            best = name;
+        }
+    }
+    OJson out = OJson::object();
+    out["against"] = "eta_3d_percent";
+    out["tests"] = n;
+    out["spearman_rho"] = rho;
+    out["best"] = best.empty() ? OJson() : OJson(best);
+    out["note"] = "each predictor as a score where higher should mean better: ff_band = -(log distance of FF from "
+                  "1.2-2.0), depth_resolution = -dR/R, sensor_aware = eta_3d predicted from the design "
+                  "(framework/method/predictors.hpp)";
+    return out;
+}
+
+struct TablesMeta {
+    std::vector<std::string> test_ids; // every test of the experiment, in file order
+    int shard_index = 1, shard_count = 1;
+};
+
+void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows, const TablesMeta &meta) {
     std::vector<std::string> columns;
     for (const auto &r : rows)
         for (const auto &[n, v] : r.values)
@@ -398,28 +689,31 @@ void writeTables(const std::string &dir, const Experiment &e, const std::vector<
     std::string csv = "test,status";
     for (const auto &c : columns) csv += "," + c;
     csv += ",error\n";
-    Json tests = Json::array();
+    OJson tests = OJson::array();
     for (const auto &r : rows) {
-        csv += r.test_id + "," + r.status;
-        Json row = {{"test", r.test_id}, {"status", r.status}};
-        for (const auto &c : columns) {
-            const double v = r.get(c);
-            csv += "," + csvCell(v);
-            row[c] = std::isfinite(v) ? Json(v) : Json(nullptr);
-        }
+        csv += r.test->id + "," + r.status;
+        for (const auto &c : columns) csv += "," + csvCell(r.get(c));
         std::string err = r.error;
         std::replace(err.begin(), err.end(), '"', '\'');
         csv += ",\"" + err + "\"\n";
-        if (!r.error.empty()) row["error"] = r.error;
-        tests.push_back(std::move(row));
+        tests.push_back(r.toJson());
     }
     writeFileAtomic((fs::path(dir) / "results.csv").string(), csv);
-    Json doc = {{"experiment", e.name},
-                {"file", e.file},
-                {"rig", e.rig_file},
-                {"units", {{"length", "mm"}, {"angle", "deg"}, {"errors_and_efficiencies", "%"}}},
-                {"tests", std::move(tests)}};
-    writeFileAtomic((fs::path(dir) / "results.json").string(), dumpJson(doc));
+    OJson doc = OJson::object();
+    doc["experiment"] = e.name;
+    doc["file"] = e.file;
+    doc["rig"] = e.rig_file;
+    doc["overrides"] = e.overrides;
+    doc["calibration"] = e.calibration;
+    doc["test_ids"] = meta.test_ids;
+    if (meta.shard_count > 1) doc["shard"] = {{"index", meta.shard_index}, {"count", meta.shard_count}};
+    doc["units"] = {{"length", "mm"}, {"angle", "deg"}, {"errors_and_efficiencies", "%"}};
+    doc["statistics"] = "with repeats: each figure is the mean over repeats; <figure>_sd the sample standard deviation, "
+                        "<figure>_ci95_low/_high the 95 % confidence interval of the mean (Student t, n - 1 degrees of "
+                        "freedom); per-repeat values under per_repeat";
+    doc["predictors"] = predictorRho(rows);
+    doc["tests"] = std::move(tests);
+    writeFileAtomic((fs::path(dir) / "results.json").string(), doc.dump(2) + "\n");
 }
 
 std::string mm(double v) { return num(v) + " mm"; }
@@ -444,30 +738,39 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
             continue;
         }
         const std::string stem = (fs::path(dir) / spec.file).string();
+        const std::string lowKey = spec.metric + "_ci95_low", highKey = spec.metric + "_ci95_high";
         if (spec.type == "bars") {
             // Grouped like the paper's Fig. 6 and 7: a group per (range, baseline[, tilt]),
-            // a bar per lens.
+            // a bar per lens; error bars: the 95 % CI of the repeats; diamonds: the paper.
             BarChart c;
             c.title = spec.title.empty() ? spec.metric : spec.title;
             c.y_label = axisLabel(spec.metric);
             c.reference_lines = spec.reference_lines;
+            c.reference_label = "paper";
             std::vector<double> lenses;
             for (const auto &r : rows)
-                if (std::find(lenses.begin(), lenses.end(), r.geometry.focal_length_mm) == lenses.end())
-                    lenses.push_back(r.geometry.focal_length_mm);
+                if (std::find(lenses.begin(), lenses.end(), r.test->geometry.focal_length_mm) == lenses.end())
+                    lenses.push_back(r.test->geometry.focal_length_mm);
             std::sort(lenses.begin(), lenses.end());
             for (double f : lenses) c.series.push_back("f = " + mm(f));
+            const bool withCi = std::any_of(rows.begin(), rows.end(), [&](const Row &r) { return std::isfinite(r.get(lowKey)); });
+            if (withCi) c.title += " (mean, 95 % CI)";
             for (const auto &r : rows) {
-                const auto &g = r.geometry;
+                const auto &g = r.test->geometry;
                 std::string label = "R " + num(g.range_mm / 1000) + " m, B " + mm(g.baseline_mm);
                 if (g.inclination_deg != 0) label += ", θ " + num(g.inclination_deg) + "°";
                 auto it = std::find_if(c.groups.begin(), c.groups.end(), [&](const BarGroup &b) { return b.label == label; });
                 if (it == c.groups.end()) {
-                    c.groups.push_back({label, std::vector<double>(lenses.size(), NAN)});
+                    const std::vector<double> none(lenses.size(), NAN);
+                    c.groups.push_back({label, none, none, none, none});
                     it = c.groups.end() - 1;
                 }
                 const size_t s = std::find(lenses.begin(), lenses.end(), g.focal_length_mm) - lenses.begin();
                 it->values[s] = r.get(spec.metric);
+                it->low[s] = r.get(lowKey);
+                it->high[s] = r.get(highKey);
+                for (const auto &[k, v] : r.test->paper)
+                    if (k == spec.metric) it->reference[s] = v;
             }
             writeChart(stem, c);
         } else {
@@ -481,17 +784,220 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
             }
             std::vector<double> ranges;
             for (const auto &r : rows) {
-                const double R = r.geometry.range_mm;
+                const double R = r.test->geometry.range_mm;
                 if (std::find(ranges.begin(), ranges.end(), R) == ranges.end()) ranges.push_back(R);
             }
             for (double R : ranges) c.series.push_back("R = " + num(R / 1000) + " m");
             for (const auto &r : rows) {
-                const int s = static_cast<int>(std::find(ranges.begin(), ranges.end(), r.geometry.range_mm) - ranges.begin());
-                c.points.push_back({r.get(spec.x), r.get(spec.metric), r.test_id, s});
+                const int s = static_cast<int>(std::find(ranges.begin(), ranges.end(), r.test->geometry.range_mm) - ranges.begin());
+                ScatterPoint pt{r.get(spec.x), r.get(spec.metric), r.test->id, s};
+                pt.y_low = r.get(lowKey);
+                pt.y_high = r.get(highKey);
+                c.points.push_back(pt);
             }
             writeChart(stem, c);
         }
     }
+}
+
+// The columns every row starts with: the test's variables and the design figures.
+void putDesign(Row &row, const Experiment &e, const ExperimentTest &t) {
+    const auto &g = t.geometry;
+    row.put("baseline_mm", g.baseline_mm);
+    row.put("focal_length_mm", g.focal_length_mm);
+    row.put("range_mm", g.range_mm);
+    row.put("camera_height_mm", g.camera_height_mm);
+    row.put("inclination_deg", g.inclination_deg);
+    row.put("form_factor", method::formFactor(g.baseline_mm, g.focal_length_mm, g.range_mm)); // Eq. 7
+    if (e.pixel_pitch_um > 0) {
+        method::StereoDesign d;
+        d.baseline_mm = g.baseline_mm;
+        d.focal_length_mm = g.focal_length_mm;
+        d.pixel_pitch_um = e.pixel_pitch_um;
+        d.image_width_px = e.image_width_px;
+        d.image_height_px = e.image_height_px;
+        d.min_disparity_px = e.min_disparity_px;
+        d.num_disparities = e.num_disparities;
+        d.camera_height_mm = g.camera_height_mm;
+        d.inclination_deg = g.inclination_deg;
+        const method::DesignFigures f = method::designFigures(d, g.range_mm, 0.25, &e.panel);
+        row.put("expected_disparity_px", f.disparity_px);
+        row.put("depth_resolution_mm", f.depth_resolution_mm);
+        row.put("stereo_field_width_mm", f.stereo_field_width_mm);
+        const method::PredictorValues p = method::predictors(d, g.range_mm, e.panel);
+        row.put("predictor.ff_band", p.ff_band);
+        row.put("predictor.depth_resolution", p.depth_resolution);
+        row.put("predictor.sensor_aware", p.sensor_aware);
+    } else {
+        row.put("predictor.ff_band", -method::formFactorBandDistance(method::formFactor(g.baseline_mm, g.focal_length_mm, g.range_mm)));
+    }
+}
+
+// One repeat of a test: the pipeline over the experiment's frames; figures averaged over
+// the frames ("<evaluator>.<metric>" and the bare main metrics) and the valid-pixel ratio.
+std::vector<std::pair<std::string, double>> runRepeat(const Experiment &e, const YAML::Node &rigNode, const PluginHost &host,
+                                                      const std::string &outDir) {
+    RigConfig rig = rigFromNode(rigNode, e.rig_file, host);
+    Pipeline pipeline(rig, host);
+    RunOptions run;
+    run.max_frames = e.frames;
+    run.out_dir = outDir;
+    run.progress = false;
+    std::vector<std::pair<std::string, double>> sums;
+    std::vector<int> counts;
+    double valid = 0;
+    int frames = 0;
+    pipeline.run(run, [&](const FrameResult &fr) {
+        ++frames;
+        valid += fr.valid_pixel_ratio;
+        for (const auto &[name, value] : fr.figures) {
+            auto it = std::find_if(sums.begin(), sums.end(), [&](const auto &p) { return p.first == name; });
+            if (it == sums.end()) {
+                sums.emplace_back(name, 0.0);
+                counts.push_back(0);
+                it = sums.end() - 1;
+            }
+            if (std::isfinite(value)) {
+                it->second += value;
+                ++counts[it - sums.begin()];
+            }
+        }
+    });
+    std::vector<std::pair<std::string, double>> out;
+    auto put = [&](const std::string &k, double v) {
+        for (auto &[n, x] : out)
+            if (n == k) return;
+        out.emplace_back(k, v);
+    };
+    for (const auto &k : kMainMetrics) put(k, NAN);
+    out.emplace_back("valid_pixel_ratio", frames ? valid / frames : NAN);
+    for (size_t k = 0; k < sums.size(); ++k) {
+        const double mean = counts[k] ? sums[k].second / counts[k] : NAN;
+        const std::string &name = sums[k].first; // "<evaluator>.<metric>"
+        const std::string metric = name.substr(name.find('.') + 1);
+        if (std::find(kMainMetrics.begin(), kMainMetrics.end(), metric) != kMainMetrics.end())
+            for (auto &[n, x] : out)
+                if (n == metric && !std::isfinite(x)) x = mean;
+        out.emplace_back(name, mean);
+    }
+    return out;
+}
+
+Row runTest(const Experiment &e, const ExperimentTest &t, const PluginHost &host, const std::string &outDir) {
+    Row row;
+    row.test = &t;
+    putDesign(row, e, t);
+    for (const auto &k : kMainMetrics) row.put(k, NAN);
+    row.put("valid_pixel_ratio", NAN);
+    const int repeats = e.repeatsOf(t);
+    const bool repeating = repeats > 1 || !e.seeds.empty();
+    if (repeating)
+        for (const auto &k : kRepeatedMetrics)
+            for (const char *suffix : {"_sd", "_ci95_low", "_ci95_high"}) row.put(k + suffix, NAN);
+    row.put("repeats", repeats);
+    const std::string testDir = (fs::path(outDir) / ("test_" + t.id)).string();
+    try {
+        std::string calibrationFile;
+        if (e.calibration == "board") {
+            const std::string name = "calibration/calib_B" + num(std::round(t.geometry.baseline_mm)) + "_f" +
+                                     num(std::round(t.geometry.focal_length_mm * 10) / 10) + ".yml";
+            calibrationFile = (fs::path(testDir) / name).string();
+            const double pitch = e.pixel_pitch_um;
+            BoardCalibrationOutcome c =
+                calibrateConfiguration(rigForTest(e, t), e.rig_file, e.board_calibration, host, calibrationFile, pitch);
+            row.put("calibration_rms_px", c.rms_px);
+            row.put("calibration_baseline_error_percent", c.baseline_error_percent);
+            row.put("calibration_focal_length_error_percent", c.focal_length_error_percent);
+            row.put("calibration_pairs_used", c.pairs_used);
+            c.file = "test_" + t.id + "/" + name; // relative: identical whichever folder the run wrote to
+            row.details["calibration"] = c.toJson();
+        }
+        // Per repeat: every figure; the outputs (disparity, cloud, views) of the first only.
+        std::vector<std::vector<std::pair<std::string, double>>> results;
+        OJson perRepeat = OJson::array();
+        for (int k = 0; k < repeats; ++k) {
+            YAML::Node rig = rigForTest(e, t, k);
+            if (!calibrationFile.empty()) rig["calibration"] = calibrationFile;
+            std::string repeatDir = testDir;
+            if (k > 0) { // later repeats: their summary and evaluator views, no images or clouds
+                repeatDir = (fs::path(testDir) / ("repeat_" + std::to_string(k))).string();
+                for (const char *o : {"disparity_png", "disparity_color", "disparity_pfm", "cloud_ply", "rectified_png"})
+                    rig["outputs"][o] = false;
+            }
+            results.push_back(runRepeat(e, rig, host, repeatDir));
+            if (repeating) {
+                OJson one = OJson::object();
+                one["seed"] = e.seedOf(k);
+                if (!e.jitter.empty()) {
+                    OJson j = OJson::object();
+                    for (const auto &[path, w] : e.jitter) {
+                        const YAML::Node n = nodeAt(rig, path);
+                        j[path] = n.IsScalar() ? OJson(n.as<double>()) : OJson();
+                    }
+                    one["jitter"] = j;
+                }
+                for (const auto &[n, v] : results.back())
+                    if (std::find(kRepeatedMetrics.begin(), kRepeatedMetrics.end(), n) != kRepeatedMetrics.end())
+                        one[n] = std::isfinite(v) ? OJson(v) : OJson();
+                perRepeat.push_back(one);
+            }
+        }
+        // Means over the repeats, in the order the first repeat reported them.
+        for (const auto &[name, unused] : results.front()) {
+            (void)unused;
+            std::vector<double> samples;
+            for (const auto &r : results)
+                for (const auto &[n, v] : r)
+                    if (n == name) samples.push_back(v);
+            const method::Summary s = method::summarize(samples);
+            row.put(name, s.n ? s.mean : NAN);
+            if (repeating && std::find(kRepeatedMetrics.begin(), kRepeatedMetrics.end(), name) != kRepeatedMetrics.end()) {
+                row.put(name + "_sd", s.n ? s.sd : NAN);
+                row.put(name + "_ci95_low", s.ci95_low);
+                row.put(name + "_ci95_high", s.ci95_high);
+            }
+        }
+        if (repeating) row.details["per_repeat"] = perRepeat;
+    } catch (const std::exception &x) {
+        row.status = "failed";
+        row.error = x.what();
+        spdlog::error("experiment: {} failed: {}", testLabel(t), x.what());
+    }
+    if (!t.paper.empty()) {
+        OJson paper = OJson::object();
+        for (const auto &[k, reported] : t.paper) {
+            const double measured = row.get(k);
+            row.put("paper_reported." + k, reported); // not "paper.": the paper evaluator's figures are named so
+            paper[k] = {{"reported", reported},
+                        {"measured", std::isfinite(measured) ? OJson(measured) : OJson()},
+                        {"difference", std::isfinite(measured) ? OJson(measured - reported) : OJson()}};
+        }
+        row.details["paper_reported"] = paper;
+    }
+    return row;
+}
+
+ExperimentResult resultOf(const std::vector<Row> &rows) {
+    ExperimentResult result;
+    for (const auto &r : rows) {
+        ExperimentRow out;
+        out.test_id = r.test->id;
+        out.geometry = r.test->geometry;
+        out.status = r.status;
+        out.error = r.error;
+        out.values = r.values;
+        result.rows.push_back(std::move(out));
+    }
+    result.failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
+    return result;
+}
+
+TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount) {
+    TablesMeta m;
+    for (const auto &t : e.tests) m.test_ids.push_back(t.id);
+    m.shard_index = shardIndex;
+    m.shard_count = shardCount;
+    return m;
 }
 
 } // namespace
@@ -511,16 +1017,40 @@ void ExperimentRow::put(const std::string &column, double value) {
     values.emplace_back(column, value);
 }
 
+std::pair<int, int> parseShard(const std::string &text) {
+    const auto slash = text.find('/');
+    int k = 0, n = 0;
+    try {
+        size_t a = 0, b = 0;
+        if (slash == std::string::npos) throw std::invalid_argument(text);
+        k = std::stoi(text.substr(0, slash), &a);
+        n = std::stoi(text.substr(slash + 1), &b);
+        if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument(text);
+    } catch (const std::logic_error &) {
+        throw Error("--shard " + text + ": expected K/N, e.g. --shard 2/8 (the second of eight shares)");
+    }
+    if (n < 1 || k < 1 || k > n) throw Error("--shard " + text + ": expected 1 <= K <= N");
+    return {k, n};
+}
+
 ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
     if (options.out_dir.empty()) throw Error("experiment: an output folder is needed (--out DIR)");
+    if (options.shard_count < 1 || options.shard_index < 1 || options.shard_index > options.shard_count)
+        throw Error("experiment: shard " + std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count) +
+                    ": expected 1 <= K <= N");
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
     if (ec) throw Error("--out " + options.out_dir + ": cannot create the folder: " + ec.message());
     std::vector<const ExperimentTest *> selected;
-    for (const auto &t : e.tests)
+    for (size_t p = 0; p < e.tests.size(); ++p) {
+        const auto &t = e.tests[p];
+        if (static_cast<int>(p % static_cast<size_t>(options.shard_count)) != options.shard_index - 1) continue;
         if (options.only.empty() || std::find(options.only.begin(), options.only.end(), t.id) != options.only.end())
             selected.push_back(&t);
-    if (selected.empty()) throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
+    }
+    if (selected.empty() && (options.shard_count == 1 || !options.only.empty()))
+        throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
+    const TablesMeta meta = metaOf(e, options.shard_index, options.shard_count);
 
     std::vector<Row> rows;
     Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
@@ -528,87 +1058,88 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     for (size_t i = 0; i < selected.size(); ++i) {
         const ExperimentTest &t = *selected[i];
         progress.update(static_cast<int64_t>(i), testLabel(t));
-        Row row;
-        row.test_id = t.id;
-        row.geometry = t.geometry;
-        const auto &g = t.geometry;
-        row.put("baseline_mm", g.baseline_mm);
-        row.put("focal_length_mm", g.focal_length_mm);
-        row.put("range_mm", g.range_mm);
-        row.put("camera_height_mm", g.camera_height_mm);
-        row.put("inclination_deg", g.inclination_deg);
-        row.put("form_factor", method::formFactor(g.baseline_mm, g.focal_length_mm, g.range_mm)); // Eq. 7
-        if (e.pixel_pitch_um > 0) {
-            method::StereoDesign d;
-            d.baseline_mm = g.baseline_mm;
-            d.focal_length_mm = g.focal_length_mm;
-            d.pixel_pitch_um = e.pixel_pitch_um;
-            d.image_width_px = e.image_width_px;
-            d.camera_height_mm = g.camera_height_mm;
-            d.inclination_deg = g.inclination_deg;
-            const method::DesignFigures f = method::designFigures(d, g.range_mm);
-            row.put("expected_disparity_px", f.disparity_px);
-            row.put("depth_resolution_mm", f.depth_resolution_mm);
-            row.put("stereo_field_width_mm", f.stereo_field_width_mm);
-        }
-        for (const auto &k : kMainMetrics) row.put(k, NAN);
-        row.put("valid_pixel_ratio", NAN);
-        row.put("seconds", NAN);
         const auto t0 = std::chrono::steady_clock::now();
-        try {
-            RigConfig rig = rigFromNode(rigForTest(e, t), e.rig_file, host);
-            Pipeline pipeline(rig, host);
-            RunOptions run;
-            run.max_frames = e.frames;
-            run.out_dir = (fs::path(options.out_dir) / ("test_" + t.id)).string();
-            run.progress = false;
-            std::vector<std::pair<std::string, double>> sums;
-            std::vector<int> counts;
-            double valid = 0;
-            int frames = 0;
-            pipeline.run(run, [&](const FrameResult &fr) {
-                ++frames;
-                valid += fr.valid_pixel_ratio;
-                for (const auto &[name, value] : fr.figures) {
-                    auto it = std::find_if(sums.begin(), sums.end(), [&](const auto &p) { return p.first == name; });
-                    if (it == sums.end()) {
-                        sums.emplace_back(name, 0.0);
-                        counts.push_back(0);
-                        it = sums.end() - 1;
-                    }
-                    if (std::isfinite(value)) {
-                        it->second += value;
-                        ++counts[it - sums.begin()];
-                    }
-                }
-            });
-            row.put("valid_pixel_ratio", frames ? valid / frames : NAN);
-            for (size_t k = 0; k < sums.size(); ++k) {
-                const double mean = counts[k] ? sums[k].second / counts[k] : NAN;
-                const std::string &name = sums[k].first; // "<evaluator>.<metric>"
-                const std::string metric = name.substr(name.find('.') + 1);
-                if (std::find(kMainMetrics.begin(), kMainMetrics.end(), metric) != kMainMetrics.end() && !std::isfinite(row.get(metric)))
-                    row.put(metric, mean);
-                row.put(name, mean);
-            }
-        } catch (const std::exception &x) {
-            row.status = "failed";
-            row.error = x.what();
-            spdlog::error("experiment: {} failed: {}", testLabel(t), x.what());
-        }
+        Row row = runTest(e, t, host, options.out_dir);
         row.put("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         rows.push_back(std::move(row));
         // Rewritten after every test: an interrupted experiment keeps what it measured.
-        writeTables(options.out_dir, e, rows);
+        writeTables(options.out_dir, e, rows, meta);
     }
+    if (rows.empty()) writeTables(options.out_dir, e, rows, meta); // an empty shard still says so
     progress.update(static_cast<int64_t>(selected.size()), "done");
     progress.finish();
     writeCharts(options.out_dir, e, rows);
-    ExperimentResult result;
-    result.failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
+    ExperimentResult result = resultOf(rows);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.rows = std::move(rows);
     return result;
+}
+
+ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host) {
+    if (dirs.empty()) throw Error("experiment merge: no folder to merge (binocle experiment merge OUT DIR...)");
+    std::vector<OJson> docs;
+    for (const auto &d : dirs) {
+        const std::string path = (fs::path(d) / "results.json").string();
+        std::ifstream in(path);
+        if (!in) throw Error("experiment merge: " + path + " cannot be read (is " + d + " an experiment's output folder?)");
+        try {
+            docs.push_back(OJson::parse(in));
+        } catch (const nlohmann::json::exception &x) {
+            throw Error("experiment merge: " + path + ": not valid JSON: " + x.what());
+        }
+        if (!docs.back().contains("file") || !docs.back().contains("tests"))
+            throw Error("experiment merge: " + path + ": no 'file' or 'tests': not an experiment's results.json");
+    }
+    const std::string file = docs[0]["file"].get<std::string>();
+    const auto overrides = docs[0].value("overrides", std::vector<std::string>{});
+    for (size_t i = 1; i < docs.size(); ++i) {
+        if (docs[i]["file"].get<std::string>() != file)
+            throw Error("experiment merge: " + dirs[i] + " holds results of " + docs[i]["file"].get<std::string>() + ", " + dirs[0] +
+                        " of " + file + ": not the same experiment");
+        if (docs[i].value("overrides", std::vector<std::string>{}) != overrides)
+            throw Error("experiment merge: " + dirs[i] + " ran with other --set overrides than " + dirs[0]);
+    }
+    const Experiment e = loadExperiment(file, host, overrides);
+    std::map<std::string, std::pair<OJson, size_t>> byId; // test id -> (row, folder index)
+    std::set<int> shards;
+    int shardCount = 0;
+    for (size_t i = 0; i < docs.size(); ++i) {
+        if (docs[i].contains("shard")) {
+            shards.insert(docs[i]["shard"]["index"].get<int>());
+            shardCount = docs[i]["shard"]["count"].get<int>();
+        }
+        for (const auto &row : docs[i]["tests"]) {
+            const std::string id = row["test"].get<std::string>();
+            if (byId.count(id))
+                throw Error("experiment merge: test " + id + " is in both " + dirs[byId[id].second] + " and " + dirs[i]);
+            byId[id] = {row, i};
+        }
+    }
+    std::vector<Row> rows;
+    for (const auto &t : e.tests) {
+        auto it = byId.find(t.id);
+        if (it == byId.end()) continue;
+        rows.push_back(Row::fromJson(it->second.first, &t));
+        byId.erase(it);
+    }
+    if (!byId.empty()) throw Error("experiment merge: test " + byId.begin()->first + " is not in " + file);
+    if (shardCount > 0 && static_cast<int>(shards.size()) == shardCount && rows.size() != e.tests.size())
+        throw Error("experiment merge: all " + std::to_string(shardCount) + " shards given but only " + std::to_string(rows.size()) +
+                    " of " + std::to_string(e.tests.size()) + " tests found");
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec) throw Error("experiment merge: " + out_dir + ": cannot create the folder: " + ec.message());
+    for (size_t i = 0; i < docs.size(); ++i)
+        for (const auto &row : docs[i]["tests"]) {
+            const fs::path from = fs::path(dirs[i]) / ("test_" + row["test"].get<std::string>());
+            if (!fs::exists(from)) continue;
+            const fs::path to = fs::path(out_dir) / from.filename();
+            if (fs::equivalent(fs::path(dirs[i]), fs::path(out_dir), ec)) continue;
+            fs::copy(from, to, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+            if (ec) throw Error("experiment merge: copying " + from.string() + " to " + to.string() + ": " + ec.message());
+        }
+    writeTables(out_dir, e, rows, metaOf(e, 1, 1));
+    writeCharts(out_dir, e, rows);
+    return resultOf(rows);
 }
 
 } // namespace binocle

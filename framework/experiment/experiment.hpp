@@ -5,7 +5,10 @@
 // results is kept; at the end come results.csv/json and charts.
 #pragma once
 
+#include "core/json.hpp"
+#include "experiment/board_calibration.hpp"
 #include "host/plugin_host.hpp"
+#include "method/design.hpp"
 
 #include <functional>
 #include <map>
@@ -29,7 +32,18 @@ struct ExperimentTest {
     std::string id;                          // "1", "2" ... as written
     TestGeometry geometry;
     std::vector<std::pair<std::string, std::string>> set; // extra overrides: rig path -> YAML value
+    int repeats = 0;                         // > 0: overrides the experiment's
+    // What the paper reported for this test (`paper:` block): figure -> value, shown
+    // beside the measured one.
+    std::vector<std::pair<std::string, double>> paper;
     int line = 0;                            // where the test stands in the file
+};
+
+// One lens of the lens table: its focal length and the rig overrides that model it
+// (e.g. the simulated head's distortion: short lenses distort more).
+struct Lens {
+    double focal_length_mm = 0;
+    std::vector<std::pair<std::string, std::string>> set; // rig path -> YAML value
 };
 
 struct ChartSpec {
@@ -51,27 +65,60 @@ struct Experiment {
     double baseline_min_mm = 0, baseline_max_mm = 0;
     double pixel_pitch_um = 0;                // for the sensor-aware figures (0: from the rig)
     int image_width_px = 0;
+    int image_height_px = 0;
+    int min_disparity_px = 0, num_disparities = 0; // the matcher's search (disparity_search_px), for the minimum range
+    std::vector<std::string> overrides;       // --set texts applied to the file
     std::map<std::string, std::vector<std::string>> bind; // variable -> rig paths
     std::vector<ExperimentTest> tests;
     std::vector<ChartSpec> charts;
+
+    // Repeats: each renders with its own noise seed, written to `seed_path` of the rig;
+    // seeds[r] when the list is given, else seed + r. jitter: rig path -> half width of
+    // a uniform perturbation of that path's value, drawn per repeat from its seed
+    // (e.g. the panel's placement and the camera's true height; the paths the rig is
+    // told stay nominal).
+    int repeats = 1;
+    uint32_t seed = 1;
+    std::vector<uint32_t> seeds;
+    std::string seed_path = "source.seed";
+    std::vector<std::pair<std::string, double>> jitter;
+
+    // "exact": the source's own calibration; "board": calibrated per test from board
+    // pairs the source renders (board_calibration).
+    std::string calibration = "exact";
+    BoardCalibrationSpec board_calibration;
+
+    std::string lens_table_file;   // absolute; empty: none
+    std::vector<Lens> lens_table;
+
+    // The test panel, for the predictors that need it (sensor-aware η3D).
+    method::PanelPlacement panel;
+
+    int repeatsOf(const ExperimentTest &t) const { return t.repeats > 0 ? t.repeats : repeats; }
+    uint32_t seedOf(int repeat) const;
 };
 
 // Reads and validates an experiment, including every test's resulting rig against the
 // plugins `host` found. Throws binocle::Error with file, line and reason; nothing runs.
-Experiment loadExperiment(const std::string &file, const PluginHost &host);
+// `overrides` (`--set repeats=10`, `--set calibration=board`) apply to the experiment
+// file's tree before it is read, like a rig's --set.
+Experiment loadExperiment(const std::string &file, const PluginHost &host, const std::vector<std::string> &overrides = {});
 
 // An experiment made in code: the base rig file and one test per geometry (ids 1, 2 ...),
 // bound to the rig the same way as a file without `bind:`. Validated like a file.
 Experiment makeExperiment(const std::string &name, const std::string &rig_file, const std::vector<TestGeometry> &tests,
                           const PluginHost &host);
 
-// The rig of one test: the base rig with the test's variables and overrides applied.
-YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t);
+// The rig of one test: the base rig with the test's lens (lens table), variables and
+// overrides applied; repeat >= 0 adds that repeat's seed and jitter when the
+// experiment repeats (repeats > 1 or a seed list).
+YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t, int repeat = -1);
 
 struct ExperimentOptions {
     std::string out_dir;
     bool progress = true;
     std::vector<std::string> only; // test ids to run; empty = all
+    int shard_index = 1, shard_count = 1; // --shard K/N: the tests whose position p (0-based, file order) has p % N == K - 1
 };
 
 // One row of results.csv / results.json: a test's variables and every figure measured.
@@ -92,6 +139,15 @@ struct ExperimentResult {
     int64_t failed = 0;
     double seconds = 0;
 };
+
+// "K/N" -> (K, N), 1 <= K <= N; throws binocle::Error naming the option and the value.
+std::pair<int, int> parseShard(const std::string &text);
+
+// Joins the results.json of shards (or partial runs) of one experiment in `dirs` into
+// `out_dir`: the rows in the experiment's test order, the predictors' rho and the charts
+// recomputed over all of them, each test's folder copied. Throws when two folders hold
+// the same test, when they come from different experiments, or when a test is missing.
+ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host);
 
 // Runs every test and writes results.csv, results.json, charts and per-test outputs
 // into out_dir/test_<id>/. Returns the rows it wrote. A test whose pipeline fails is

@@ -151,6 +151,12 @@ ObjectOffset locateKnownObject(const CloudView &cloud, const KnownObject &truth,
     off.true_range_mm = truth.nearFaceRangeMm();
     const double half = truth.size_mm[0] / 2 + lateral_margin_mm;
     options.lateral = {off.true_x_mm - half, off.true_x_mm + half};
+    // Heights too: only up to the object's top + the margin. Without this a larger,
+    // denser object within the lateral window and the range search (E2: the tree's
+    // crown, 2-5 m up, 1-3 m behind or in front of the marker) wins the band search and
+    // the object is "found" metres off.
+    const double top = truth.center_mm[2] + truth.size_mm[2] / 2 + lateral_margin_mm;
+    if (top < options.grid.z.max_mm) options.grid.z.max_mm = std::max(top, options.grid.z.min_mm + options.grid.cell_mm);
     options.expected_range_mm = off.true_range_mm;
     const PanelReading r = readPanel(cloud, options);
     if (!r.registered) return off;

@@ -71,7 +71,8 @@ struct ObjectOffset {
 };
 
 // Reads a known object where it should be, as the E1 panel is read (readPanel): the
-// points above the ground within its true lateral span +- lateral_margin_mm, the densest
+// points above the ground within its true lateral span +- lateral_margin_mm and below its
+// true top + lateral_margin_mm, the densest
 // range band near its near face (options' range search and margin), the lateral edges
 // of the band's occupied front-view cells and the median range. Robust where the top
 // view's regions merge (a smeared cloud joining the object to its neighbours).

@@ -214,11 +214,40 @@ void drawBars(Canvas &c, const BarChart &ch, int w, int h) {
             }
             const double y = yOf(v);
             c.rect(x + 1, y, bw - 2, p.bottom - y, paletteColor(static_cast<int>(s)));
-            c.text(x + bw / 2, y - 4, fmt(v), 11, kAxis, Anchor::Middle);
+            const auto &grp = ch.groups[g];
+            const double lo = s < grp.low.size() ? grp.low[s] : NAN, hi = s < grp.high.size() ? grp.high[s] : NAN;
+            double labelY = y;
+            if (std::isfinite(lo) && std::isfinite(hi)) { // whisker with caps
+                const double cx = x + bw / 2, cap = std::min(6.0, bw / 4);
+                c.line(cx, yOf(lo), cx, yOf(hi), kAxis, 1.3);
+                c.line(cx - cap, yOf(lo), cx + cap, yOf(lo), kAxis, 1.3);
+                c.line(cx - cap, yOf(hi), cx + cap, yOf(hi), kAxis, 1.3);
+                labelY = std::min(y, yOf(hi));
+            }
+            if (s < grp.reference.size() && std::isfinite(grp.reference[s])) {
+                const double rx = x + bw / 2, ry = yOf(grp.reference[s]);
+                c.line(rx - 6, ry, rx, ry - 6, kAxis, 2);
+                c.line(rx, ry - 6, rx + 6, ry, kAxis, 2);
+                c.line(rx + 6, ry, rx, ry + 6, kAxis, 2);
+                c.line(rx, ry + 6, rx - 6, ry, kAxis, 2);
+                labelY = std::min(labelY, ry - 6);
+            }
+            c.text(x + bw / 2, labelY - 4, fmt(v), 11, kAxis, Anchor::Middle);
         }
         c.text(p.left + g * gw + gw / 2, p.bottom + 22, ch.groups[g].label, 14, kAxis, Anchor::Middle);
     }
     legend(c, ch.series, p.right + 20, p.top + 10);
+    const bool anyReference = std::any_of(ch.groups.begin(), ch.groups.end(), [](const BarGroup &g) {
+        return std::any_of(g.reference.begin(), g.reference.end(), [](double v) { return std::isfinite(v); });
+    });
+    if (anyReference) {
+        const double lx = p.right + 27, ly = p.top + 10 + 22.0 * ch.series.size();
+        c.line(lx - 6, ly - 4, lx, ly - 10, kAxis, 2);
+        c.line(lx, ly - 10, lx + 6, ly - 4, kAxis, 2);
+        c.line(lx + 6, ly - 4, lx, ly + 2, kAxis, 2);
+        c.line(lx, ly + 2, lx - 6, ly - 4, kAxis, 2);
+        c.text(p.right + 40, ly + 1, ch.reference_label.empty() ? "reference" : ch.reference_label, 14, kAxis);
+    }
 }
 
 void drawScatter(Canvas &c, const ScatterChart &ch, int w, int h) {
@@ -248,6 +277,11 @@ void drawScatter(Canvas &c, const ScatterChart &ch, int w, int h) {
     c.text((p.left + p.right) / 2, h - 18.0, ch.x_label, 15, kAxis, Anchor::Middle);
     for (const auto &pt : ch.points) {
         if (!std::isfinite(pt.x) || !std::isfinite(pt.y)) continue;
+        if (std::isfinite(pt.y_low) && std::isfinite(pt.y_high)) {
+            c.line(xOf(pt.x), yOf(pt.y_low), xOf(pt.x), yOf(pt.y_high), paletteColor(pt.series), 1.3);
+            c.line(xOf(pt.x) - 4, yOf(pt.y_low), xOf(pt.x) + 4, yOf(pt.y_low), paletteColor(pt.series), 1.3);
+            c.line(xOf(pt.x) - 4, yOf(pt.y_high), xOf(pt.x) + 4, yOf(pt.y_high), paletteColor(pt.series), 1.3);
+        }
         c.circle(xOf(pt.x), yOf(pt.y), 5, paletteColor(pt.series));
         if (!pt.label.empty()) c.text(xOf(pt.x) + 7, yOf(pt.y) - 6, pt.label, 11, kAxis);
     }

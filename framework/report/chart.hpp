@@ -4,6 +4,8 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -12,6 +14,11 @@ namespace binocle {
 struct BarGroup {
     std::string label;          // e.g. "R = 6 m, B = 100 mm"
     std::vector<double> values; // one per series; NaN = missing (drawn as "n/a")
+    // Error bars (e.g. the 95 % confidence interval of repeats): low and high end per
+    // series; empty, or NaN for one series: no bar.
+    std::vector<double> low, high;
+    // A reference value per series drawn as a black diamond (e.g. the paper's figure); NaN: none.
+    std::vector<double> reference;
 };
 
 struct BarChart {
@@ -21,12 +28,14 @@ struct BarChart {
     std::vector<BarGroup> groups;
     double y_min = 0, y_max = 100;
     std::vector<double> reference_lines; // horizontal dashed lines (e.g. 70 %)
+    std::string reference_label;         // legend entry of BarGroup::reference ("paper")
 };
 
 struct ScatterPoint {
     double x = 0, y = 0;
     std::string label; // drawn beside the point (e.g. test number)
     int series = 0;
+    double y_low = NAN, y_high = NAN; // vertical error bar; NaN: none
 };
 
 struct ScatterChart {

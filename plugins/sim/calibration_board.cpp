@@ -47,7 +47,7 @@ BoardSettings BoardSettings::fromYaml(const std::string &text) {
     }
     if (b.cols < 2 || b.rows < 2) throw SceneError("calibration_board: cols and rows must be >= 2 (inner corners)");
     if (!(b.square_mm > 0)) throw SceneError("calibration_board.square_mm: expected a value > 0");
-    if (b.poses < 1) throw SceneError("calibration_board.poses: expected a value >= 1");
+    if (b.poses < 0) throw SceneError("calibration_board.poses: expected a value >= 0 (0: a new pose every frame, endless)");
     if (b.max_tilt_deg < 0 || b.max_tilt_deg > 60) throw SceneError("calibration_board.max_tilt_deg: expected 0..60");
     return b;
 }

@@ -14,7 +14,7 @@ namespace binocle::sim {
 struct BoardSettings {
     int cols = 9, rows = 6;      // inner corners per row / per column (cv::findChessboardCorners)
     double square_mm = 25;
-    int poses = 12;
+    int poses = 12;              // frames before end of stream; 0: endless (the caller takes what it needs)
     double max_tilt_deg = 30;    // largest rotation of the board about its horizontal and vertical axes
     uint32_t seed = 1;
 

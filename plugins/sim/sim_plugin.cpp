@@ -78,6 +78,8 @@ public:
             Param::path("scene", "").help("scene YAML (plugins/sim/README.md); empty: the built-in E1 panel"),
             Param::real("range_mm", "0").min(0).unit("mm")
                 .help("> 0: moves the scene's main object so that its near face is at this range; 0: as in the scene"),
+            Param::real("main_object_lateral_mm", "0").unit("mm")
+                .help("moves the scene's main object along X (lateral) by this much (placement jitter of repeats)"),
             Param::integer("frames", "1").min(0).help("frames before end of stream; 0 = endless"),
             Param::real("forward_mm_per_frame", "0").unit("mm").help("rig displacement along the range axis per frame"),
             Param::real("lateral_mm_per_frame", "0").unit("mm").help("rig displacement along the lateral axis per frame"),
@@ -96,7 +98,7 @@ public:
             Param::choice("color", "gray", "gray|bgr").help("GRAY8 or BGR8 images"),
             Param::integer("antialias", "2").min(1).max(8).help("samples per axis per sensor pixel"),
             Param::yaml("calibration_board", "")
-                .help("{cols, rows, square_mm, poses}: render a chessboard in varied poses instead of the scene"),
+                .help("{cols, rows, square_mm, poses (0: endless), max_tilt_deg, seed}: render a chessboard in varied poses instead of the scene"),
         };
     }
 
@@ -146,6 +148,11 @@ public:
                     scene_ = sim::Scene::load(path);
                 }
                 if (p.real("range_mm") > 0) scene_.placeMainObjectAtRange(p.real("range_mm"));
+                if (const double dx = p.real("main_object_lateral_mm"); dx != 0) {
+                    if (scene_.mainObject < 0)
+                        throw sim::SceneError("main_object_lateral_mm: the scene '" + scene_.name + "' has no main object");
+                    scene_.moveObject(scene_.mainObject, sim::Vec3(dx, 0, 0));
+                }
             }
         } catch (const sim::SceneError &e) {
             throw Error(BINOCLE_ERR_INVALID_ARGUMENT, std::string("sim: ") + e.what());

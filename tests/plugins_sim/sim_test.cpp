@@ -11,6 +11,7 @@
 #include <opencv2/calib3d.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
@@ -101,6 +102,28 @@ TEST(SimPlugin, RangeMotionAndEndOfStream) {
         EXPECT_NEAR(d, 384.615385 * 150 / (12000 - 500 * i), 1e-3);
     }
     EXPECT_FALSE(src->grab());
+}
+
+TEST(SimPlugin, MainObjectLateralShiftMovesThePanelAndItsTruth) {
+    auto still = makeSim("{range_mm: 6000}");
+    auto moved = makeSim("{range_mm: 6000, main_object_lateral_mm: 120}");
+    const YAML::Node a = YAML::Load(still->grab()->metadata()), b = YAML::Load(moved->grab()->metadata());
+    EXPECT_NEAR(b["panel"]["center_mm"][0].as<double>() - a["panel"]["center_mm"][0].as<double>(), 120, 1e-9);
+    EXPECT_DOUBLE_EQ(b["panel"]["range_mm"].as<double>(), 6000); // range and size unchanged
+    EXPECT_DOUBLE_EQ(b["panel"]["width_mm"].as<double>(), a["panel"]["width_mm"].as<double>());
+}
+
+TEST(SimPlugin, CalibrationBoardWithoutAPoseCountIsEndless) {
+    auto src = makeSim("{calibration_board: {cols: 9, rows: 6, square_mm: 25, poses: 0}}");
+    std::vector<std::string> origins;
+    for (int i = 0; i < 15; ++i) { // more than the 12 poses of the default
+        auto f = src->grab();
+        ASSERT_TRUE(f) << "pose " << i;
+        origins.push_back(YAML::Dump(YAML::Load(f->metadata())["board"]["origin_camera_mm"]));
+    }
+    std::sort(origins.begin(), origins.end());
+    EXPECT_EQ(std::unique(origins.begin(), origins.end()), origins.end()) << "every frame a new pose";
+    EXPECT_NE(errorOf([] { makeSim("{calibration_board: {poses: -1}}"); }).find("poses: expected a value >= 0"), std::string::npos);
 }
 
 TEST(SimPlugin, PublishesItsExactCalibration) {

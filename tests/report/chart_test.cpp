@@ -71,3 +71,34 @@ TEST(Chart, ScatterWritesPngAndSvg) {
 }
 
 } // namespace
+
+namespace {
+
+size_t count(const std::string &text, const std::string &what) {
+    size_t n = 0;
+    for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+    return n;
+}
+
+TEST(Chart, ErrorBarsAndReferenceMarksAreDrawnWhereGiven) {
+    BarChart c = sample();
+    const size_t plainLines = count(toSvg(c), "<line");
+    // Two whiskers (3 lines each: bar and two caps) and one paper diamond (4 lines + 4 in the legend).
+    c.groups[0].low = {35, NAN, 78, NAN};
+    c.groups[0].high = {45, NAN, 86, NAN};
+    c.groups[1].reference = {NAN, NAN, 78, NAN};
+    c.reference_label = "paper";
+    const std::string svg = toSvg(c);
+    EXPECT_EQ(count(svg, "<line"), plainLines + 2 * 3 + 4 + 4);
+    EXPECT_NE(svg.find(">paper<"), std::string::npos);
+
+    ScatterChart s;
+    s.points = {{1.0, 80, "1", 0}, {2.0, 60, "2", 0}};
+    const size_t scatterLines = count(toSvg(s), "<line");
+    s.points[0].y_low = 75;
+    s.points[0].y_high = 85;
+    EXPECT_EQ(count(toSvg(s), "<line"), scatterLines + 3);
+    EXPECT_FALSE(toImage(s).empty());
+}
+
+} // namespace
