@@ -86,11 +86,12 @@ const binocle::PluginHost &host() {
     return *h;
 }
 
-binocle::RigConfig rigFor(const Pair &p, bool sgbm, int matchers, bool grids) {
+binocle::RigConfig rigFor(const Pair &p, bool sgbm, int matchers, bool grids, int disparities = 64) {
     std::string y = "name: bench\nsource:\n  plugin: replay\n  layout: glob\n  left: " + p.left + "\n  right: " + p.right +
                     "\n  color: gray\n  loop: true\ncalibration: " + p.calibration + "\n";
-    y += sgbm ? "matcher:\n  plugin: sgbm\n  num_disparities: 64\n  block_size: 5\n"
-              : "matcher:\n  plugin: bm\n  num_disparities: 64\n  block_size: 15\n";
+    const std::string n = std::to_string(disparities);
+    y += sgbm ? "matcher:\n  plugin: sgbm\n  num_disparities: " + n + "\n  block_size: 5\n"
+              : "matcher:\n  plugin: bm\n  num_disparities: " + n + "\n  block_size: 15\n";
     y += "transforms:\n  - plugin: ground\n    camera_height_mm: " + std::to_string(kCameraHeightMm) +
          "\n    inclination_deg: " + std::to_string(kInclinationDeg) + "\n";
     if (grids) y += "evaluators:\n  - plugin: density_grids\n";
@@ -224,15 +225,15 @@ int64_t residentKiB() {
     return resident * ::sysconf(_SC_PAGESIZE) / 1024;
 }
 
-// Replay of one 320 x 240 pair, looped, through bm | ground | density_grids with
-// frames.jsonl written: resident memory must stay flat.
+// Replay of one 320 x 240 pair, looped, through bm (32 disparities, two instances) |
+// ground | density_grids with frames.jsonl written: resident memory must stay flat.
 void BM_ReplaySoak(benchmark::State &state) {
     const char *env = std::getenv("BINOCLE_SOAK_FRAMES");
     const int64_t frames = env ? std::atoll(env) : 100000;
     const Pair &p = pairAt(cv::Size(320, 240));
     const std::string out = p.dir + "/soak";
     for (auto _ : state) {
-        binocle::Pipeline pipe(rigFor(p, false, 1, true), host());
+        binocle::Pipeline pipe(rigFor(p, false, 2, true, 32), host());
         binocle::RunOptions o;
         o.max_frames = frames;
         o.progress = false;
