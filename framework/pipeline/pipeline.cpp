@@ -9,6 +9,8 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
+#include "core/json.hpp"
+#include "core/progress.hpp"
 #include "pipeline/stage_queue.hpp"
 
 #include <chrono>
@@ -16,12 +18,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 #include <thread>
-#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 namespace fs = std::filesystem;
@@ -29,7 +29,6 @@ namespace fs = std::filesystem;
 namespace binocle {
 
 using Clock = std::chrono::steady_clock;
-using OrderedJson = nlohmann::ordered_json;
 
 namespace {
 
@@ -51,7 +50,7 @@ bool sourceIsLive(const std::string &statistics) {
 // statistics that source.h names: `unpaired` at the top level (pairing), and
 // `failed_buffers`, `underrun_buffers`, `corrupt`, `dropped_by_driver` anywhere
 // (camera or transport), each named by where it sits ("cameras.left.failed_buffers").
-void sourceDrops(const YAML::Node &node, const std::string &path, OrderedJson &camera) {
+void sourceDrops(const YAML::Node &node, const std::string &path, Json &camera) {
     static const char *kCameraKeys[] = {"failed_buffers", "underrun_buffers", "corrupt", "dropped_by_driver"};
     if (node.IsMap()) {
         for (const auto &kv : node) {
@@ -74,34 +73,6 @@ void sourceDrops(const YAML::Node &node, const std::string &path, OrderedJson &c
     }
 }
 
-class Progress {
-public:
-    explicit Progress(bool enabled, int64_t total) : enabled_(enabled), total_(total), tty_(::isatty(2) != 0) {}
-    void update(int64_t done, double fps) {
-        if (!enabled_) return;
-        const auto now = Clock::now();
-        if (!tty_ && done > 1 && now - last_ < std::chrono::seconds(2)) return;
-        last_ = now;
-        char buf[128];
-        if (total_ > 0)
-            std::snprintf(buf, sizeof buf, "frame %lld/%lld  %.1f fps", static_cast<long long>(done), static_cast<long long>(total_), fps);
-        else
-            std::snprintf(buf, sizeof buf, "frame %lld  %.1f fps", static_cast<long long>(done), fps);
-        std::cerr << (tty_ ? "\r" : "") << buf << (tty_ ? "" : "\n") << std::flush;
-        printed_ = true;
-    }
-    ~Progress() {
-        if (printed_ && tty_) std::cerr << "\n";
-    }
-
-private:
-    bool enabled_;
-    int64_t total_;
-    bool tty_;
-    bool printed_ = false;
-    Clock::time_point last_{};
-};
-
 // One line per frame, flushed as it is written: a killed run keeps every finished frame.
 class FramesFile {
 public:
@@ -114,9 +85,9 @@ public:
     ~FramesFile() {
         if (file_) std::fclose(file_);
     }
-    void write(const OrderedJson &line) {
+    void write(const Json &line) {
         if (!file_) return;
-        const std::string text = line.dump() + "\n";
+        const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
         if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0)
             throw Error(path_ + ": cannot write: " + std::strerror(errno));
     }
@@ -408,7 +379,7 @@ void Pipeline::cloudAndTransforms(RunState &s) {
 void Pipeline::evaluate(RunState &s) {
     while (std::optional<std::unique_ptr<Job>> job = s.clouded.pop()) {
         FrameResult &r = (*job)->r;
-        r.metrics = OrderedJson::object();
+        r.metrics = Json::object();
         r.figures.clear();
         if (!(*job)->failed && !s.aborted && !evaluators_.empty()) {
             try {
@@ -436,7 +407,7 @@ void Pipeline::evaluate(RunState &s) {
                 in.rig_yaml = rig_.resolved_yaml.c_str();
                 in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
                 for (auto &slot : evaluators_) {
-                    OrderedJson figures = OrderedJson::object();
+                    Json figures = Json::object();
                     slot->target = &figures;
                     slot->flat = &r.figures;
                     try {
@@ -477,7 +448,7 @@ void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const 
     if (o.cloud_ply) writePly((d / ("cloud_" + std::string(stem) + ".ply")).string(), r.cloud);
 }
 
-OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
+Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
     outDir_ = options.out_dir;
     if (!outDir_.empty()) {
         std::error_code ec;
@@ -485,7 +456,7 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
         if (ec) throw Error("--out " + outDir_ + ": cannot create the folder: " + ec.message());
     }
     const RuntimeOptions &rt = rig_.runtime;
-    OrderedJson summary = OrderedJson::object();
+    Json summary = Json::object();
     summary["rig"] = rig_.file;
     summary["name"] = rig_.name;
     summary["source"] = rig_.source.plugin;
@@ -530,7 +501,7 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
         threads.emplace_back([&] { evaluate(s); });
 
         // Stage 5, here: outputs, the frame's line, observers; then the job goes back.
-        Progress progress(options.progress, options.max_frames);
+        Progress progress(options.progress, "frame", options.max_frames);
         while (std::optional<std::unique_ptr<Job>> job = s.evaluated.pop()) {
             FrameResult &r = (*job)->r;
             if (!(*job)->failed && !s.aborted) {
@@ -539,7 +510,7 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
                     if (!outDir_.empty()) writeOutputs(r, outDir_);
                     r.seconds += secondsSince(t0);
                     r.latency_s = secondsSince((*job)->grabbed);
-                    OrderedJson line = OrderedJson::object();
+                    Json line = Json::object();
                     line["index"] = r.index;
                     line["sequence"] = r.sequence;
                     line["valid_pixel_ratio"] = r.valid_pixel_ratio;
@@ -551,8 +522,7 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
                     if (onFrame) onFrame(r);
                     for (FrameObserver *o : observers_) o->onFrame(r);
                     ++count;
-                    const double elapsed = secondsSince(start);
-                    progress.update(count, elapsed > 0 ? count / elapsed : 0.0);
+                    progress.update(count);
                 } catch (const std::exception &e) {
                     s.fail(e.what());
                 }
@@ -573,9 +543,9 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
     std::string failure = s.failure;
     if (failure.empty()) {
         try {
-            OrderedJson totals = OrderedJson::object();
+            Json totals = Json::object();
             for (auto &slot : evaluators_) {
-                OrderedJson figures = OrderedJson::object();
+                Json figures = Json::object();
                 slot->target = &figures;
                 slot->evaluator->finish();
                 slot->target = nullptr;
@@ -601,9 +571,9 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
     if (!failure.empty()) summary["error"] = failure;
     if (!outDir_.empty()) summary["frames_file"] = "frames.jsonl";
 
-    OrderedJson dropped = OrderedJson::object();
+    Json dropped = Json::object();
     dropped["by_policy"] = s.droppedByPolicy;
-    OrderedJson camera = OrderedJson::object();
+    Json camera = Json::object();
     int64_t unpaired = 0;
     if (!stats.empty()) {
         summary["source_statistics"] = stats;
@@ -629,7 +599,7 @@ OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(co
                                   {"image_width", calibration_.image_size.width},
                                   {"image_height", calibration_.image_size.height}};
     }
-    if (!outDir_.empty()) writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump(2));
+    if (!outDir_.empty()) writeFileAtomic((fs::path(outDir_) / "summary.json").string(), dumpJson(summary));
     if (!failure.empty()) throw Error(failure);
     return summary;
 }
