@@ -4,6 +4,7 @@
 #include "config/rig_config.hpp"
 #include "core/json.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/stop_signal.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -28,11 +29,16 @@ int runRig(const RunArgs &args) {
     options.out_dir = args.out;
     options.progress = !args.quiet;
     Pipeline pipeline(rig, host);
+    StopSignalGuard signals; // Ctrl-C / SIGTERM: finish the frames in flight, write the summary
+    options.stop = &StopSignalGuard::requested();
     Json summary = pipeline.run(options);
-    spdlog::info("binocle run: {} frame(s) of rig '{}'{}", summary.value("frame_count", int64_t{0}), rig.name,
+    const bool interrupted = summary.value("status", "") == "interrupted";
+    spdlog::info("binocle run: {} frame(s) of rig '{}'{}{}", summary.value("frame_count", int64_t{0}), rig.name,
+                 interrupted ? " (interrupted)" : "",
                  options.out_dir.empty() ? "" : " written to " + options.out_dir + " (summary.json)");
     if (options.out_dir.empty()) std::cout << dumpJson(summary);
-    return 0;
+    // Interrupted: the usual 128 + signal, though everything finished was written.
+    return interrupted ? 128 + StopSignalGuard::signalNumber() : 0;
 }
 
 Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluators",
@@ -41,8 +47,11 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "  disparity_NNNNNN.png        16-bit disparity, KITTI convention (d * 256, 0 = invalid)\n"
               "  disparity_color_NNNNNN.png  colourised disparity (invalid = black)\n"
               "  cloud_NNNNNN.ply            binary PLY, millimetres, frame stated in the header\n"
-              "and summary.json (per-frame figures, evaluator metrics, status). Without --out\n"
-              "the summary goes to standard output.\n"
+              "and frames.jsonl (one line of figures per frame, written as it finishes) and\n"
+              "summary.json (evaluator metrics, drops, status). Without --out the summary goes\n"
+              "to standard output. SIGINT/SIGTERM stop the run cleanly (status interrupted, exit\n"
+              "128 + signal); a second signal ends it at once. The rig's runtime: block sets the\n"
+              "policy (README \"Runtime\").\n"
               "Example: binocle run RIG.yaml --frames 10 --set matcher.num_disparities=128 --set transforms.0.inclination_deg=10",
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<RunArgs>();

@@ -306,6 +306,7 @@ public:
 
     std::string statistics() override {
         std::ostringstream s;
+        s << "live: true\n"; // frames come on the cameras' clock: the host defaults to the latest policy
         s << "layout: " << (sideBySide_ ? "side_by_side" : "two_cameras") << "\n";
         s << "frames: " << sequence_ << "\n";
         s << "unpaired: " << unpaired_ << "\n";
