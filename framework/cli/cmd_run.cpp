@@ -17,6 +17,8 @@ int run(const Args &args) {
     RigConfig rig = loadRigFromArgs(args, host);
     RunOptions options;
     options.max_frames = args.integer("--frames", -1);
+    if (args.has("--frames") && options.max_frames < 1)
+        throw Error("option --frames = " + args.get("--frames") + ": expected a number of frames >= 1");
     options.out_dir = args.get("--out", "");
     options.progress = !args.has("--quiet");
     Pipeline pipeline(rig, host);

@@ -2,10 +2,14 @@
 // `binocle`: entry point and subcommand dispatch.
 #include "cli/command.hpp"
 #include "core/error.hpp"
+#include "input/image_file.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 
 #include <binocle/abi.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -70,25 +74,19 @@ std::vector<std::string> Args::all(const std::string &name) const {
 long long Args::integer(const std::string &name, long long def) const {
     if (!has(name)) return def;
     const std::string v = get(name);
-    try {
-        size_t used = 0;
-        long long x = std::stoll(v, &used);
-        if (used == v.size()) return x;
-    } catch (const std::logic_error &) {
-    }
-    throw Error("option " + name + " = '" + v + "': expected an integer");
+    int64_t x = 0;
+    std::string why;
+    if (binocle::input::parseInteger(v, x, &why)) return x;
+    throw Error("option " + name + " = '" + binocle::input::printable(v) + "': " + why);
 }
 
 double Args::real(const std::string &name, double def) const {
     if (!has(name)) return def;
     const std::string v = get(name);
-    try {
-        size_t used = 0;
-        double x = std::stod(v, &used);
-        if (used == v.size()) return x;
-    } catch (const std::logic_error &) {
-    }
-    throw Error("option " + name + " = '" + v + "': expected a number");
+    double x = 0;
+    std::string why;
+    if (binocle::input::parseReal(v, x, &why)) return x;
+    throw Error("option " + name + " = '" + binocle::input::printable(v) + "': " + why);
 }
 
 } // namespace binocle::cli
@@ -110,6 +108,9 @@ void usage(std::ostream &os) {
 
 int main(int argc, char **argv) {
     using namespace binocle::cli;
+    // OpenCV's own limit for the formats input/image_file.cpp does not read a header of
+    // (TIFF, WebP, ...): the same pixel count, before OpenCV first reads it.
+    ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(binocle::input::kMaxImagePixels).c_str(), 0);
     std::vector<std::string> args(argv + 1, argv + argc);
     if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
         usage(args.empty() ? std::cerr : std::cout);

@@ -2,6 +2,8 @@
 // A small JSON value: build and dump.
 #include "core/json.hpp"
 
+#include "input/text.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -32,7 +34,10 @@ const Json *Json::get(const std::string &key) const {
     return nullptr;
 }
 
-std::string jsonEscape(const std::string &s) {
+std::string jsonEscape(const std::string &text) {
+    // JSON is UTF-8: a name or path with ill-formed bytes (a non-UTF-8 file name, a
+    // plugin's message) is written with U+FFFD in their place, never as invalid JSON.
+    const std::string s = input::sanitizeUtf8(text);
     std::string out = "\"";
     for (unsigned char c : s) {
         switch (c) {

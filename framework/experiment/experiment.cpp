@@ -5,12 +5,18 @@
 #include "config/rig_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+#include "input/yaml_file.hpp"
 #include "method/design.hpp"
 #include "pipeline/pipeline.hpp"
 #include "report/chart.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -60,20 +66,37 @@ struct Reader {
     }
     [[noreturn]] void fail(const YAML::Node &n, const std::string &what) const { throw Error(where(n) + ": " + what); }
     void checkKeys(const YAML::Node &map, const std::vector<std::string> &valid, const std::string &what) const {
+        if (!map.IsMap()) fail(map, what + ": expected a map");
         for (const auto &kv : map) {
-            const std::string k = kv.first.as<std::string>();
+            const std::string k = key(kv.first);
             if (std::find(valid.begin(), valid.end(), k) != valid.end()) continue;
             const std::string hint = nearest(k, valid);
             fail(kv.first, what + ": unknown key '" + k + "'" + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
                                " (valid keys: " + join(valid) + ")");
         }
     }
+    // One strict reader of numbers (input/numbers.hpp): decimal, finite.
     double number(const YAML::Node &n, const std::string &what) const {
         double v = 0;
-        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-            fail(n, what + ": value '" + (n.IsScalar() ? n.Scalar() : std::string("(not a scalar)")) + "' is not a number");
+        std::string why;
+        if (!n.IsScalar() || !input::parseReal(n.Scalar(), v, &why))
+            fail(n, what + ": value '" + (n.IsScalar() ? input::printable(n.Scalar()) : std::string("(not a scalar)")) +
+                        "' is not valid: " + (why.empty() ? "expected a number" : why));
         return v;
     }
+    // A whole number in [min, max], checked before the cast.
+    int64_t integer(const YAML::Node &n, const std::string &what, int64_t min, int64_t max) const {
+        const double v = number(n, what);
+        if (!(v >= static_cast<double>(min) && v <= static_cast<double>(max)) || v != std::floor(v))
+            fail(n, what + ": value '" + n.Scalar() + "' is not valid: expected a whole number " + std::to_string(min) +
+                        ".." + std::to_string(max));
+        return static_cast<int64_t>(v);
+    }
+    std::string text(const YAML::Node &n, const std::string &what) const {
+        if (!n.IsScalar()) fail(n, what + ": expected a text, not " + (n.IsMap() ? "a map" : n.IsSequence() ? "a list" : "nothing"));
+        return n.Scalar();
+    }
+    static std::string key(const YAML::Node &k) { return k.IsScalar() ? k.Scalar() : "(a non-scalar key)"; }
     std::vector<double> numbers(const YAML::Node &n, const std::string &what) const {
         if (!n.IsSequence()) fail(n, what + ": expected a list of numbers, e.g. [2.8, 4, 8]");
         std::vector<double> out;
@@ -89,7 +112,7 @@ std::map<std::string, std::vector<std::string>> defaultBind(const YAML::Node &ri
     for (const auto &v : kVariables) b[v] = {"source." + v};
     if (YAML::Node t = rig["transforms"]; t && t.IsSequence())
         for (size_t i = 0; i < t.size(); ++i)
-            if (t[i]["plugin"] && t[i]["plugin"].as<std::string>() == "ground") {
+            if (t[i].IsMap() && t[i]["plugin"].IsScalar() && t[i]["plugin"].Scalar() == "ground") {
                 b["camera_height_mm"].push_back("transforms." + std::to_string(i) + ".camera_height_mm");
                 b["inclination_deg"].push_back("transforms." + std::to_string(i) + ".inclination_deg");
             }
@@ -145,31 +168,27 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
     Reader r{e.file};
     YAML::Node root;
     try {
-        root = YAML::LoadFile(e.file);
-    } catch (const YAML::ParserException &x) {
-        throw Error(e.file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
-                    ": YAML syntax error: " + x.msg);
+        root = input::loadYamlFile(e.file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
     if (!root.IsMap()) throw Error(e.file + ": expected a map with rig:, tests: ...");
     r.checkKeys(root, kTopKeys, "experiment");
-    e.name = root["name"] ? root["name"].as<std::string>() : fs::path(e.file).stem().string();
-    e.description = root["description"] ? root["description"].as<std::string>() : "";
+    e.name = root["name"] ? r.text(root["name"], "name") : fs::path(e.file).stem().string();
+    e.description = root["description"] ? r.text(root["description"], "description") : "";
     if (!root["rig"] || !root["rig"].IsScalar()) throw Error(e.file + ": missing key 'rig' (the base rig file)");
     fs::path rigPath = root["rig"].Scalar();
     if (rigPath.is_relative()) rigPath = fs::path(e.file).parent_path() / rigPath;
     e.rig_file = rigPath.lexically_normal().string();
     if (!fs::exists(e.rig_file)) r.fail(root["rig"], "rig: file '" + e.rig_file + "' does not exist");
     try {
-        e.rig = YAML::LoadFile(e.rig_file);
-    } catch (const YAML::ParserException &x) {
-        throw Error(e.rig_file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
-                    ": YAML syntax error: " + x.msg);
+        e.rig = input::loadYamlFile(e.rig_file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
-    if (root["frames"]) {
-        const double f = r.number(root["frames"], "frames");
-        if (f < 1 || f != std::floor(f)) r.fail(root["frames"], "frames: expected a whole number >= 1");
-        e.frames = static_cast<int64_t>(f);
-    }
+    if (!e.rig.IsMap()) throw Error(e.rig_file + ": expected a YAML map with source, matcher, ... at the top level");
+    const Reader rigReader{e.rig_file};
+    if (root["frames"]) e.frames = r.integer(root["frames"], "frames", 1, 1000000);
     if (root["lenses_mm"]) e.lenses_mm = r.numbers(root["lenses_mm"], "lenses_mm");
     if (root["baseline_range_mm"]) {
         auto b = r.numbers(root["baseline_range_mm"], "baseline_range_mm");
@@ -178,11 +197,16 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         e.baseline_max_mm = b[1];
     }
     if (root["pixel_pitch_um"]) e.pixel_pitch_um = r.number(root["pixel_pitch_um"], "pixel_pitch_um");
-    else if (e.rig["source"] && e.rig["source"]["pixel_pitch_um"]) e.pixel_pitch_um = e.rig["source"]["pixel_pitch_um"].as<double>();
-    else if (e.rig["source"] && e.rig["source"]["plugin"] && e.rig["source"]["plugin"].as<std::string>() == "sim")
+    else if (e.rig.IsMap() && e.rig["source"].IsMap() && e.rig["source"]["pixel_pitch_um"])
+        e.pixel_pitch_um = rigReader.number(e.rig["source"]["pixel_pitch_um"], "source.pixel_pitch_um");
+    else if (e.rig.IsMap() && e.rig["source"].IsMap() && e.rig["source"]["plugin"].IsScalar() &&
+             e.rig["source"]["plugin"].Scalar() == "sim")
         e.pixel_pitch_um = 20.8; // the sim's default: the Videre head's effective pixel
-    if (root["image_width_px"]) e.image_width_px = static_cast<int>(r.number(root["image_width_px"], "image_width_px"));
-    else if (e.rig["source"] && e.rig["source"]["image_width"]) e.image_width_px = e.rig["source"]["image_width"].as<int>();
+    if (!(e.pixel_pitch_um >= 0)) r.fail(root["pixel_pitch_um"], "pixel_pitch_um: expected a positive pitch in um");
+    constexpr int64_t kMaxWidth = 32768;
+    if (root["image_width_px"]) e.image_width_px = static_cast<int>(r.integer(root["image_width_px"], "image_width_px", 1, kMaxWidth));
+    else if (e.rig.IsMap() && e.rig["source"].IsMap() && e.rig["source"]["image_width"])
+        e.image_width_px = static_cast<int>(rigReader.integer(e.rig["source"]["image_width"], "source.image_width", 1, kMaxWidth));
     else if (e.pixel_pitch_um == 20.8) e.image_width_px = 320;
 
     e.bind = defaultBind(e.rig);
@@ -190,12 +214,13 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         if (!b.IsMap()) r.fail(b, "bind: expected a map variable -> list of rig paths");
         r.checkKeys(b, kVariables, "bind");
         for (const auto &kv : b) {
+            const std::string var = Reader::key(kv.first);
             std::vector<std::string> paths;
             if (kv.second.IsScalar()) paths.push_back(kv.second.Scalar());
             else if (kv.second.IsSequence())
-                for (const auto &p : kv.second) paths.push_back(p.as<std::string>());
-            else r.fail(kv.second, "bind." + kv.first.as<std::string>() + ": expected a rig path or a list of them");
-            e.bind[kv.first.as<std::string>()] = paths;
+                for (const auto &p : kv.second) paths.push_back(r.text(p, "bind." + var));
+            else r.fail(kv.second, "bind." + var + ": expected a rig path or a list of them");
+            e.bind[var] = paths;
         }
     }
     // Defaults of the variables: the experiment's `defaults:`, else the base rig's values.
@@ -212,10 +237,15 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
                 found = false;
                 break;
             }
-            n = n.IsSequence() ? n[std::stoul(part)] : n[part];
+            int64_t index = 0;
+            if (n.IsSequence() && !input::parseInteger(part, index, nullptr, 0, static_cast<int64_t>(n.size()) - 1)) {
+                found = false;
+                break;
+            }
+            n = n.IsSequence() ? n[static_cast<size_t>(index)] : n[part];
         }
         double v = 0;
-        if (found && n.IsDefined() && n.IsScalar() && YAML::convert<double>::decode(n, v)) {
+        if (found && n.IsDefined() && n.IsScalar() && input::parseReal(n.Scalar(), v)) {
             *field(defaults, var) = v;
             haveDefault.insert(var);
         }
@@ -224,8 +254,9 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         if (!d.IsMap()) r.fail(d, "defaults: expected a map of variables");
         r.checkKeys(d, kVariables, "defaults");
         for (const auto &kv : d) {
-            *field(defaults, kv.first.as<std::string>()) = r.number(kv.second, "defaults." + kv.first.as<std::string>());
-            haveDefault.insert(kv.first.as<std::string>());
+            const std::string var = Reader::key(kv.first);
+            *field(defaults, var) = r.number(kv.second, "defaults." + var);
+            haveDefault.insert(var);
         }
     }
 
@@ -237,8 +268,12 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         if (!tn.IsMap()) r.fail(tn, "tests[" + std::to_string(i) + "]: expected a map (id, baseline_mm, focal_length_mm, range_mm, ...)");
         r.checkKeys(tn, kTestKeys, "tests[" + std::to_string(i) + "]");
         ExperimentTest t;
-        t.id = tn["id"] ? tn["id"].as<std::string>() : std::to_string(i + 1);
+        t.id = tn["id"] ? r.text(tn["id"], "tests[" + std::to_string(i) + "].id") : std::to_string(i + 1);
         t.line = tn.Mark().line + 1;
+        // The id names the folder test_<id>/ under --out: it must stay a file name.
+        if (std::string why; !input::isSafeName(t.id, &why))
+            r.fail(tn["id"], "tests[" + std::to_string(i) + "].id '" + input::printable(t.id) + "': " + why +
+                                 " (it names the folder test_<id>/ under --out)");
         if (!ids.insert(t.id).second) r.fail(tn, "test " + t.id + ": id used twice");
         t.geometry = defaults;
         for (const auto &var : kVariables) {
@@ -250,7 +285,7 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         }
         if (YAML::Node s = tn["set"]) {
             if (!s.IsMap()) r.fail(s, "test " + t.id + ": set: expected a map of rig paths to values");
-            for (const auto &kv : s) t.set.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+            for (const auto &kv : s) t.set.emplace_back(r.text(kv.first, "test " + t.id + ": set"), yamlText(kv.second));
         }
         checkGeometry(e, t, r, tn);
         // The whole rig of this test must be valid before anything runs.
@@ -267,13 +302,17 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host) {
         for (const auto &cn : c) {
             r.checkKeys(cn, {"type", "metric", "x", "title", "file", "reference_lines"}, "charts");
             ChartSpec s;
-            s.type = cn["type"] ? cn["type"].as<std::string>() : "bars";
+            s.type = cn["type"] ? r.text(cn["type"], "charts.type") : "bars";
             if (s.type != "bars" && s.type != "scatter") r.fail(cn["type"], "charts: type '" + s.type + "': expected bars or scatter");
             if (!cn["metric"]) r.fail(cn, "charts: missing key 'metric' (e.g. eta_3d_percent)");
-            s.metric = cn["metric"].as<std::string>();
-            if (cn["x"]) s.x = cn["x"].as<std::string>();
-            s.title = cn["title"] ? cn["title"].as<std::string>() : "";
-            s.file = cn["file"] ? cn["file"].as<std::string>() : s.metric + (s.type == "scatter" ? "_vs_" + s.x : "");
+            s.metric = r.text(cn["metric"], "charts.metric");
+            if (cn["x"]) s.x = r.text(cn["x"], "charts.x");
+            s.title = cn["title"] ? r.text(cn["title"], "charts.title") : "";
+            s.file = cn["file"] ? r.text(cn["file"], "charts.file") : s.metric + (s.type == "scatter" ? "_vs_" + s.x : "");
+            // The chart is written as <--out>/<file>.png|svg: a file name, not a path.
+            if (std::string why; !input::isSafeName(s.file, &why))
+                r.fail(cn["file"] ? cn["file"] : cn, "charts.file '" + input::printable(s.file) + "': " + why +
+                                                         " (the chart's file name under --out, without extension)");
             if (cn["reference_lines"]) s.reference_lines = r.numbers(cn["reference_lines"], "charts.reference_lines");
             e.charts.push_back(s);
         }
@@ -294,10 +333,11 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     e.rig_file = fs::absolute(rig_file, ec).lexically_normal().string();
     if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
     try {
-        e.rig = YAML::LoadFile(e.rig_file);
-    } catch (const YAML::Exception &x) {
-        throw Error(e.rig_file + ": cannot read YAML: " + x.msg);
+        e.rig = input::loadYamlFile(e.rig_file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
+    if (!e.rig.IsMap()) throw Error(e.rig_file + ": expected a YAML map with source, matcher, ... at the top level");
     e.bind = defaultBind(e.rig);
     for (size_t i = 0; i < tests.size(); ++i) {
         ExperimentTest t;
@@ -479,6 +519,49 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
     }
 }
 
+// The rows of an earlier run in the same --out, for a partial run (--tests) to merge
+// into: results.csv/json then keep every test, not only the ones run again. Results of
+// another experiment, or a table that cannot be read, are refused rather than replaced.
+std::map<std::string, Row> earlierRows(const Experiment &e, const std::string &dir) {
+    std::map<std::string, Row> rows;
+    const fs::path file = fs::path(dir) / "results.json";
+    std::error_code ec;
+    if (!fs::exists(file, ec)) return rows;
+    const std::string refusal = "; a partial run (--tests) would replace its table: choose another --out, or run all tests";
+    nlohmann::ordered_json doc;
+    try {
+        std::ifstream in(file);
+        doc = nlohmann::ordered_json::parse(in);
+    } catch (const nlohmann::json::exception &x) {
+        throw Error("--out " + dir + ": " + file.string() + " cannot be read (" + x.what() + ")" + refusal);
+    }
+    const auto text = [&](const char *key) {
+        return doc.is_object() && doc.contains(key) && doc[key].is_string() ? doc[key].get<std::string>() : std::string();
+    };
+    if (text("experiment") != e.name || text("file") != e.file)
+        throw Error("--out " + dir + " holds the results of experiment '" + input::printable(text("experiment")) + "' (" +
+                    input::printable(text("file")) + "), not of '" + e.name + "' (" + e.file + ")" + refusal);
+    if (!doc.contains("tests") || !doc["tests"].is_array())
+        throw Error("--out " + dir + ": " + file.string() + " has no list of tests" + refusal);
+    for (const auto &t : doc["tests"]) {
+        if (!t.is_object() || !t.contains("test") || !t["test"].is_string()) continue;
+        const std::string id = t["test"].get<std::string>();
+        const auto it = std::find_if(e.tests.begin(), e.tests.end(), [&](const ExperimentTest &x) { return x.id == id; });
+        if (it == e.tests.end()) continue; // a test no longer in the file
+        Row row;
+        row.test = &*it;
+        for (const auto &[key, value] : t.items()) {
+            if (key == "test") continue;
+            if (key == "status" && value.is_string()) row.status = value.get<std::string>();
+            else if (key == "error" && value.is_string()) row.error = value.get<std::string>();
+            else if (value.is_number()) row.values.emplace_back(key, value.get<double>());
+            else if (value.is_null()) row.values.emplace_back(key, NAN);
+        }
+        rows[id] = std::move(row);
+    }
+    return rows;
+}
+
 } // namespace
 
 Json runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
@@ -491,6 +574,22 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
         if (options.only.empty() || std::find(options.only.begin(), options.only.end(), t.id) != options.only.end())
             selected.push_back(&t);
     if (selected.empty()) throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
+    for (const auto &id : options.only)
+        if (std::none_of(e.tests.begin(), e.tests.end(), [&](const ExperimentTest &t) { return t.id == id; }))
+            throw Error("experiment " + e.file + ": --tests names test '" + input::printable(id) + "', which it does not hold");
+    const bool partial = selected.size() < e.tests.size();
+    std::map<std::string, Row> earlier = partial ? earlierRows(e, options.out_dir) : std::map<std::string, Row>{};
+    // The table: this run's rows, and an earlier run's for the tests not run again, in
+    // the experiment's order.
+    auto merged = [&](const std::vector<Row> &fresh) {
+        std::vector<Row> all;
+        for (const auto &t : e.tests) {
+            auto it = std::find_if(fresh.begin(), fresh.end(), [&](const Row &r) { return r.test == &t; });
+            if (it != fresh.end()) all.push_back(*it);
+            else if (auto old = earlier.find(t.id); old != earlier.end()) all.push_back(old->second);
+        }
+        return all;
+    };
 
     std::vector<Row> rows;
     ProgressBar bar(options.progress, selected.size());
@@ -538,7 +637,10 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
             pipeline.run(run, [&](const FrameResult &fr) {
                 ++frames;
                 valid += fr.valid_pixel_ratio;
-                for (const auto &[name, value] : fr.figures) {
+                for (const auto &figure : fr.figures) {
+                    // Not a structured binding: C++17 lets no lambda capture one (clang refuses).
+                    const std::string &name = figure.first;
+                    const double value = figure.second;
                     auto it = std::find_if(sums.begin(), sums.end(), [&](const auto &p) { return p.first == name; });
                     if (it == sums.end()) {
                         sums.emplace_back(name, 0.0);
@@ -568,10 +670,10 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
         row.put("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         rows.push_back(std::move(row));
         // Rewritten after every test: an interrupted experiment keeps what it measured.
-        writeTables(options.out_dir, e, rows);
+        writeTables(options.out_dir, e, merged(rows));
     }
     bar.show(selected.size(), "done");
-    writeCharts(options.out_dir, e, rows);
+    writeCharts(options.out_dir, e, merged(rows));
     Json result = Json::object();
     result.set("experiment", e.name);
     result.set("tests", static_cast<int64_t>(rows.size()));

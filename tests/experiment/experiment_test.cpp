@@ -97,6 +97,44 @@ TEST(Experiment, RunWritesTablesChartsAndPerTestOutputs) {
     EXPECT_TRUE(std::filesystem::exists(dir.str("out/test_b/summary.json")));
 }
 
+TEST(Experiment, APartialRerunMergesIntoTheTableItFinds) {
+    TempDir dir;
+    const std::string file = dir.str("three.yaml");
+    writeText(file, experimentText("  - {id: a, range_mm: 6000, baseline_mm: 100, focal_length_mm: 8}\n"
+                                   "  - {id: b, range_mm: 6000, baseline_mm: 150, focal_length_mm: 8}\n"
+                                   "  - {id: c, range_mm: 12000, baseline_mm: 190, focal_length_mm: 12}\n"));
+    auto r = runCli("experiment " + file + " --quiet --out " + dir.str("out"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string before = readTextFile(dir.str("out/results.csv"));
+    auto lineOf = [](const std::string &csv, const std::string &id) {
+        const size_t at = csv.find("\n" + id + ",");
+        return at == std::string::npos ? std::string() : csv.substr(at + 1, csv.find('\n', at + 1) - at - 1);
+    };
+    // Test b again, into the same folder: a and c keep their rows, in the file's order.
+    r = runCli("experiment " + file + " --quiet --tests b --out " + dir.str("out"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string after = readTextFile(dir.str("out/results.csv"));
+    EXPECT_EQ(std::count(after.begin(), after.end(), '\n'), 4) << after;
+    EXPECT_EQ(lineOf(after, "a"), lineOf(before, "a"));
+    EXPECT_EQ(lineOf(after, "c"), lineOf(before, "c"));
+    EXPECT_LT(after.find("\na,"), after.find("\nb,"));
+    EXPECT_LT(after.find("\nb,"), after.find("\nc,"));
+    const std::string json = readTextFile(dir.str("out/results.json"));
+    for (const char *id : {"\"test\": \"a\"", "\"test\": \"b\"", "\"test\": \"c\""})
+        EXPECT_NE(json.find(id), std::string::npos) << id;
+
+    // Another experiment's table is refused, not replaced.
+    const std::string other = dir.str("other.yaml");
+    writeText(other, experimentText("  - {id: b, range_mm: 6000, baseline_mm: 150, focal_length_mm: 8}\n"
+                                    "  - {id: z, range_mm: 6000, baseline_mm: 150, focal_length_mm: 4}\n"));
+    r = runCli("experiment " + other + " --quiet --tests b --out " + dir.str("out"));
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("holds the results of experiment 'small' (" + file + "), not of 'small' (" + other + ")"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(readTextFile(dir.str("out/results.csv")), after);
+}
+
 TEST(Design, RanksByFormFactorAndRefusesBadInput) {
     TempDir dir;
     auto r = runCli("design --range 6000 --lenses 2.8,8,16 --baselines 100,150 --top 3 --out " + dir.str());
