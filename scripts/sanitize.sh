@@ -15,6 +15,8 @@ dir="${BINOCLE_SANITIZE_BUILD_DIR:-build-sanitize}"
 seconds="${BINOCLE_FUZZ_SECONDS:-20}"
 jobs="$(nproc)"
 start=$(date +%s)
+# As scripts/build.sh: ccache hashes paths relative to the checkout.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
 if [ ! -f "$dir/build.ninja" ]; then
   launcher=()
   if command -v ccache >/dev/null 2>&1; then
