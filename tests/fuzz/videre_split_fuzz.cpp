@@ -11,6 +11,11 @@
 #include <stdexcept>
 #include <vector>
 
+namespace binocle::videre1394 {
+// The device layer is chosen at link time (videre_device.hpp); the splitter needs none.
+Bus &bus() { throw std::logic_error("videre_split_fuzz: no IEEE-1394 bus"); }
+} // namespace binocle::videre1394
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (size < 9) return 0;
     const uint32_t width = 1 + (data[0] | (data[1] << 8)) % 160;
