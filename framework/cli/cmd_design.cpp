@@ -8,6 +8,8 @@
 #include "core/error.hpp"
 #include "core/json.hpp"
 #include "experiment/experiment.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 #include "method/design.hpp"
 
 #include <algorithm>
@@ -26,13 +28,11 @@ std::vector<double> numberList(const std::string &option, const std::string &tex
     std::vector<double> out;
     std::stringstream ss(text);
     for (std::string item; std::getline(ss, item, ',');) {
-        try {
-            size_t used = 0;
-            out.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::logic_error &) {
-            throw Error(option + " " + text + ": '" + item + "' is not a number (expected e.g. 2.8,4,8)");
-        }
+        double v = 0;
+        if (!input::parseReal(item, v)) // decimal and finite: no "nan", "inf" or "0x1p3"
+            throw Error(option + " " + input::printable(text) + ": '" + input::printable(item) +
+                        "' is not a number (expected e.g. 2.8,4,8)");
+        out.push_back(v);
     }
     return out;
 }
