@@ -113,6 +113,13 @@ std::string scalarText(const YAML::Node &n) {
     return n.IsMap() ? "(a map)" : "(a list)";
 }
 
+// A value as YAML text in flow style ("[1, 2]"): how lists reach the plugins.
+std::string flowText(const YAML::Node &n) {
+    YAML::Emitter e;
+    e << YAML::Flow << n;
+    return e.c_str();
+}
+
 // A map key as text; a non-scalar key (YAML allows "? [a, b]") is named, not converted.
 std::string keyText(const YAML::Node &k) { return k.IsScalar() ? k.Scalar() : "(" + scalarText(k) + " as a key)"; }
 
@@ -211,7 +218,7 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
             if (!e.IsScalar() || (ints ? !input::parseInteger(e.Scalar(), i) : !input::parseReal(e.Scalar(), x)))
                 bad(what);
         }
-        out.setText(d.name, d.type, scalarText(n), isExplicit);
+        out.setText(d.name, d.type, flowText(n), isExplicit);
         break;
     }
     case BINOCLE_PARAM_YAML: {
