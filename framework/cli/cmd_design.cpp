@@ -9,6 +9,8 @@
 #include "core/json.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/predictor_choice.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
 
@@ -39,13 +41,11 @@ std::vector<double> numberList(const std::string &option, const std::string &tex
     std::vector<double> out;
     std::stringstream ss(text);
     for (std::string item; std::getline(ss, item, ',');) {
-        try {
-            size_t used = 0;
-            out.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::logic_error &) {
-            throw UsageError(option + " " + text + ": '" + item + "' is not a number (expected e.g. 2.8,4,8)");
-        }
+        double v = 0;
+        if (!input::parseReal(item, v)) // decimal and finite: no "nan", "inf" or "0x1p3"
+            throw UsageError(option + " " + input::printable(text) + ": '" + input::printable(item) +
+                        "' is not a number (expected e.g. 2.8,4,8)");
+        out.push_back(v);
     }
     return out;
 }

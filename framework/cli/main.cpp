@@ -3,6 +3,7 @@
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
 #include "core/log.hpp"
+#include "input/image_file.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -52,6 +53,9 @@ LogOptions plainLog(const std::string &program) {
 } // namespace
 
 int main(int argc, char **argv) {
+    // OpenCV's own limit for the formats input/image_file.cpp does not read a header of
+    // (TIFF, WebP, ...): the same pixel count, before OpenCV first reads it.
+    ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(input::kMaxImagePixels).c_str(), 0);
     std::map<const CLI::App *, Runner> runners;
     std::unique_ptr<CLI::App> app = makeApp(runners);
     std::string logLevel = "info", logFile;

@@ -3,6 +3,9 @@
 #include "config/rig_config.hpp"
 
 #include "core/error.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+#include "input/yaml_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -76,8 +79,6 @@ std::vector<std::string> splitPath(const std::string &path) {
     return parts;
 }
 
-bool isIndex(const std::string &s) { return !s.empty() && std::all_of(s.begin(), s.end(), ::isdigit); }
-
 // Everything needed to say where a value came from.
 struct Context {
     std::string file;
@@ -105,12 +106,22 @@ struct Context {
     }
 };
 
+// A value as it reads in a message: control characters escaped, long values cut.
 std::string scalarText(const YAML::Node &n) {
-    if (n.IsScalar()) return n.Scalar();
+    if (n.IsScalar()) return input::printable(n.Scalar());
+    if (!n.IsDefined() || n.IsNull()) return "(nothing)";
+    return n.IsMap() ? "(a map)" : "(a list)";
+}
+
+// A value as YAML text in flow style ("[1, 2]"): how lists reach the plugins.
+std::string flowText(const YAML::Node &n) {
     YAML::Emitter e;
     e << YAML::Flow << n;
     return e.c_str();
 }
+
+// A map key as text; a non-scalar key (YAML allows "? [a, b]") is named, not converted.
+std::string keyText(const YAML::Node &k) { return k.IsScalar() ? k.Scalar() : "(" + scalarText(k) + " as a key)"; }
 
 std::string describeChoices(const binocle_param_desc &d) {
     std::string c = d.choices ? d.choices : "";
@@ -149,14 +160,15 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
         if (d.flags & BINOCLE_PARAM_FLAG_ODD) what = "an odd integer";
         if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) what += " >= " + fmtNumber(d.min);
         if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) what += " <= " + fmtNumber(d.max);
-        if (!n.IsScalar()) bad(what);
-        try {
-            size_t used = 0;
-            v = std::stoll(n.Scalar(), &used, 0);
-            if (used != n.Scalar().size()) bad(what);
-        } catch (const std::logic_error &) {
-            bad(what);
-        }
+        // One strict reader for the file and --set alike: decimal only ("0640" is not 416),
+        // range-checked before any narrowing.
+        std::string why;
+        int64_t parsed = 0;
+        if (!n.IsScalar() || !input::parseInteger(n.Scalar(), parsed, &why))
+            bad(why.find("leading zeros") != std::string::npos || why.find("64 bits") != std::string::npos
+                    ? what + " (" + why + ")"
+                    : what);
+        v = parsed;
         if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) bad(what);
         if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) bad(what);
         if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) bad(what);
@@ -166,14 +178,7 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
     }
     case BINOCLE_PARAM_DOUBLE: {
         double v = 0;
-        if (!n.IsScalar()) bad("a number");
-        try {
-            size_t used = 0;
-            v = std::stod(n.Scalar(), &used);
-            if (used != n.Scalar().size()) bad("a number");
-        } catch (const std::logic_error &) {
-            bad("a number");
-        }
+        if (!n.IsScalar() || !input::parseReal(n.Scalar(), v)) bad("a decimal number");
         if (!std::isfinite(v)) bad("a finite number");
         checkRange(v, "a number");
         out.setDouble(d.name, v, isExplicit);
@@ -208,14 +213,12 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
         const char *what = ints ? "a list of integers, e.g. [1, 2]" : "a list of numbers, e.g. [0.1, 0.2]";
         if (!n.IsSequence()) bad(what);
         for (const auto &e : n) {
-            try {
-                if (ints) (void)e.as<long long>();
-                else (void)e.as<double>();
-            } catch (const YAML::Exception &) {
+            int64_t i = 0;
+            double x = 0;
+            if (!e.IsScalar() || (ints ? !input::parseInteger(e.Scalar(), i) : !input::parseReal(e.Scalar(), x)))
                 bad(what);
-            }
         }
-        out.setText(d.name, d.type, scalarText(n), isExplicit);
+        out.setText(d.name, d.type, flowText(n), isExplicit);
         break;
     }
     case BINOCLE_PARAM_YAML: {
@@ -236,7 +239,7 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
         ctx.fail(block, where, "expected a map of settings for plugin '" + record.name + "'");
     if (block.IsMap()) {
         for (const auto &kv : block) {
-            const std::string key = kv.first.as<std::string>();
+            const std::string key = keyText(kv.first);
             if (key == "plugin") continue;
             if (std::find(names.begin(), names.end(), key) != names.end()) continue;
             std::string hint = nearest(key, names);
@@ -377,7 +380,7 @@ std::vector<PluginBlock> blockList(const YAML::Node &node, const std::string &wh
 RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &host) {
     if (!root.IsMap()) throw Error(ctx.file + ": expected a YAML map with source, matcher, ... at the top level");
     for (const auto &kv : root) {
-        const std::string key = kv.first.as<std::string>();
+        const std::string key = keyText(kv.first);
         if (std::find(kTopKeys.begin(), kTopKeys.end(), key) != kTopKeys.end()) continue;
         std::string hint = nearest(key, kTopKeys);
         throw Error(ctx.at(kv.first, key).str() + ": unknown key '" + key + "'" +
@@ -387,7 +390,12 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     RigConfig rig;
     rig.file = ctx.file;
     rig.base_dir = ctx.base_dir;
-    rig.name = root["name"] ? root["name"].as<std::string>() : fs::path(ctx.file).stem().string();
+    if (YAML::Node n = root["name"]; n.IsDefined() && !n.IsNull()) {
+        if (!n.IsScalar()) ctx.fail(n, "name", "value " + scalarText(n) + " is not valid: expected a text");
+        rig.name = n.Scalar();
+    } else {
+        rig.name = fs::path(ctx.file).stem().string();
+    }
     rig.source = block(root["source"], "source", BINOCLE_KIND_STEREO_SOURCE, host, ctx);
     rig.matcher = block(root["matcher"], "matcher", BINOCLE_KIND_MATCHER, host, ctx);
     rig.transforms = blockList(root["transforms"], "transforms", BINOCLE_KIND_CLOUD_TRANSFORM, host, ctx);
@@ -402,7 +410,7 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
         if (!o.IsMap()) ctx.fail(o, "outputs", "expected a map (disparity_png: true, ...)");
         for (const auto &kv : o) {
-            const std::string key = kv.first.as<std::string>();
+            const std::string key = keyText(kv.first);
             if (std::find(kOutputKeys.begin(), kOutputKeys.end(), key) == kOutputKeys.end()) {
                 std::string hint = nearest(key, kOutputKeys);
                 throw Error(ctx.at(kv.first, "outputs." + key).str() + ": outputs: unknown key '" + key + "'" +
@@ -423,7 +431,7 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
         flag("rectified_png", rig.outputs.rectified_png);
         if (YAML::Node n = o["max_range_mm"]) {
             double v = 0;
-            if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !(v > 0))
+            if (!n.IsScalar() || !input::parseReal(n.Scalar(), v) || !(v > 0))
                 ctx.fail(n, "outputs.max_range_mm", "value '" + scalarText(n) + "' is not valid: expected a positive number of mm");
             rig.outputs.max_range_mm = v;
         }
@@ -435,6 +443,13 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     return rig;
 }
 
+RigConfig rigFromTree(YAML::Node root, const std::string &file, const std::vector<Override> &overrides,
+                      const PluginHost &host) {
+    for (const auto &o : overrides) applyOverride(root, o);
+    Context ctx{file, fs::path(file).parent_path().string(), overrides};
+    return build(root, ctx, host);
+}
+
 } // namespace
 
 void applyOverride(YAML::Node &root, const Override &o) {
@@ -442,20 +457,26 @@ void applyOverride(YAML::Node &root, const Override &o) {
     if (parts.empty()) throw Error("--set " + o.text + ": empty key");
     YAML::Node value;
     try {
-        value = YAML::Load(o.value);
-    } catch (const YAML::Exception &e) {
-        throw Error("--set " + o.text + ": value is not valid YAML: " + e.msg);
+        value = input::parseYaml(o.value, "--set " + o.text);
+    } catch (const input::YamlError &e) {
+        throw Error(e.what());
     }
+    // A list index: decimal, within the list; checked before any conversion.
+    auto index = [&](const YAML::Node &list, const std::string &part) -> size_t {
+        int64_t i = 0;
+        const int64_t last = static_cast<int64_t>(list.size()) - 1;
+        if (!input::parseInteger(part, i, nullptr, 0, last))
+            throw Error("--set " + o.text + ": '" + input::printable(part) + "' is not an index of the list (" +
+                        (last < 0 ? std::string("the list is empty") : "0.." + std::to_string(last)) + ")");
+        return static_cast<size_t>(i);
+    };
     // Walk with fresh handles: yaml-cpp node assignment would rebind, not descend.
     std::vector<YAML::Node> chain{root};
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
         YAML::Node cur = chain.back();
         YAML::Node next;
         if (cur.IsSequence()) {
-            if (!isIndex(parts[i]) || std::stoul(parts[i]) >= cur.size())
-                throw Error("--set " + o.text + ": '" + parts[i] + "' is not an index of the list (0.." +
-                            std::to_string(cur.size() ? cur.size() - 1 : 0) + ")");
-            next = cur[std::stoul(parts[i])];
+            next = cur[index(cur, parts[i])];
         } else if (cur.IsMap() || cur.IsNull() || !cur.IsDefined()) {
             next = cur[parts[i]];
             if (!next.IsDefined() || next.IsNull()) {
@@ -469,9 +490,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
     }
     YAML::Node last = chain.back();
     if (last.IsSequence()) {
-        if (!isIndex(parts.back()) || std::stoul(parts.back()) >= last.size())
-            throw Error("--set " + o.text + ": '" + parts.back() + "' is not an index of the list");
-        last[std::stoul(parts.back())] = value;
+        last[index(last, parts.back())] = value;
     } else if (last.IsScalar()) {
         throw Error("--set " + o.text + ": the parent of '" + parts.back() + "' is a scalar value");
     } else {
@@ -485,16 +504,22 @@ RigConfig loadRig(const std::string &file, const std::vector<Override> &override
     if (!fs::exists(abs)) throw Error("rig file " + file + " does not exist");
     YAML::Node root;
     try {
-        root = YAML::LoadFile(abs);
-    } catch (const YAML::ParserException &e) {
-        throw Error(abs + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                    ": YAML syntax error: " + e.msg);
-    } catch (const YAML::Exception &e) {
-        throw Error(abs + ": cannot read YAML: " + e.msg);
+        root = input::loadYamlFile(abs);
+    } catch (const input::YamlError &e) {
+        throw Error(e.what());
     }
-    for (const auto &o : overrides) applyOverride(root, o);
-    Context ctx{abs, fs::path(abs).parent_path().string(), overrides};
-    return build(root, ctx, host);
+    return rigFromTree(root, abs, overrides, host);
+}
+
+RigConfig loadRigText(const std::string &text, const std::string &file, const std::vector<Override> &overrides,
+                      const PluginHost &host) {
+    YAML::Node root;
+    try {
+        root = input::parseYaml(text, file);
+    } catch (const input::YamlError &e) {
+        throw Error(e.what());
+    }
+    return rigFromTree(root, file, overrides, host);
 }
 
 RigConfig rigFromNode(const YAML::Node &root, const std::string &file, const PluginHost &host) {

@@ -77,6 +77,9 @@ struct Override {
 
 // Loads, applies overrides, validates against the plugins `host` found.
 RigConfig loadRig(const std::string &file, const std::vector<Override> &overrides, const PluginHost &host);
+// Same from the rig's text; `file` names it in messages and anchors relative paths.
+RigConfig loadRigText(const std::string &text, const std::string &file, const std::vector<Override> &overrides,
+                      const PluginHost &host);
 // Same from a YAML tree already loaded (experiments build rigs this way).
 RigConfig rigFromNode(const YAML::Node &root, const std::string &file, const PluginHost &host);
 

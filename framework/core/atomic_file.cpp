@@ -16,7 +16,17 @@ namespace fs = std::filesystem;
 
 namespace binocle {
 
-std::string readTextFile(const std::string &path) {
+std::string readTextFile(const std::string &path, uintmax_t maxBytes) {
+    // Checked first: std::ifstream opens a folder and then throws
+    // "basic_filebuf::underflow" when read.
+    std::error_code ec;
+    const auto status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) throw Error("cannot read " + path + ": no such file");
+    if (!fs::is_regular_file(status)) throw Error("cannot read " + path + ": not a regular file");
+    const uintmax_t size = fs::file_size(path, ec);
+    if (!ec && size > maxBytes)
+        throw Error("cannot read " + path + ": the file holds " + std::to_string(size) + " bytes; expected at most " +
+                    std::to_string(maxBytes));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error("cannot read " + path + ": " + std::strerror(errno));
     std::ostringstream ss;

@@ -2,13 +2,15 @@
 // Whole-file reads and crash-safe writes: a result file is either complete or absent.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 
 namespace binocle {
 
-// Throws binocle::Error naming the path when it cannot be read.
-std::string readTextFile(const std::string &path);
+// Throws binocle::Error naming the path when it cannot be read, is not a regular file or
+// holds more than maxBytes.
+std::string readTextFile(const std::string &path, uintmax_t maxBytes = uintmax_t{64} << 20);
 
 // Writes to "<path>.tmp-<pid>", flushes, then renames over path. On failure the old
 // file (if any) is untouched and the temporary is removed.

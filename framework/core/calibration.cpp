@@ -5,11 +5,20 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
+#include "input/image_file.hpp"
+
+#include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <sstream>
 
 namespace binocle {
 
-double StereoCalibration::baselineMm() const { return T.empty() ? 0.0 : cv::norm(T); }
+double StereoCalibration::baselineMm() const {
+    // hypot, not cv::norm: |T| of T = (-1e308, 0, 0) is 1e308, not inf.
+    if (T.total() != 3 || T.depth() != CV_64F) return T.empty() ? 0.0 : cv::norm(T);
+    const double *t = T.ptr<double>();
+    return std::hypot(std::hypot(t[0], t[1]), t[2]);
+}
 
 double StereoCalibration::focalLengthPx() const {
     if (!P1.empty()) return P1.at<double>(0, 0);
@@ -47,6 +56,11 @@ cv::Mat readMatrix(const cv::FileStorage &fs, const char *key, int rows, int col
                                   "x" + std::to_string(cols) + " matrix)");
         return {};
     }
+    // The declared size first: "rows: 100000000" must not allocate before being refused.
+    if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt() || n["rows"].real() < 1 || n["cols"].real() < 1 ||
+        n["rows"].real() * n["cols"].real() > 16)
+        throw Error(origin + ": calibration key '" + key + "' is not a small OpenCV matrix (expected !!opencv-matrix with " +
+                    (rows > 0 ? std::to_string(rows) + "x" + std::to_string(cols) : std::string("at most 16 values")) + ")");
     cv::Mat m;
     try {
         n >> m;
@@ -64,6 +78,67 @@ cv::Mat readMatrix(const cv::FileStorage &fs, const char *key, int rows, int col
 
 } // namespace
 
+namespace {
+
+std::string number(double v) {
+    if (std::isnan(v)) return "nan"; // not "-nan": the sign of a NaN means nothing here
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// image_width / image_height: whole, positive, within the image limits; read as real
+// numbers first so that 1e300 or 640.5 are refused instead of cast.
+int imageSide(const cv::FileStorage &fs, const char *key, const std::string &origin) {
+    const cv::FileNode n = fs[key];
+    if (n.empty()) throw Error(origin + ": calibration key '" + key + "' is missing (expected the image size in pixels)");
+    if (!n.isInt() && !n.isReal())
+        throw Error(origin + ": calibration key '" + key + "' is not a number (expected the image size in pixels)");
+    const double v = n.real();
+    if (!(v >= 1 && v <= static_cast<double>(input::kMaxImageSide)) || v != std::floor(v))
+        throw Error(origin + ": calibration key '" + key + "' = " + number(v) + ": expected a whole number of pixels 1.." +
+                    std::to_string(input::kMaxImageSide));
+    return static_cast<int>(v);
+}
+
+void requireFinite(const cv::Mat &m, const char *key, const std::string &origin) {
+    for (int r = 0; r < m.rows; ++r)
+        for (int c = 0; c < m.cols; ++c)
+            if (!std::isfinite(m.at<double>(r, c)))
+                throw Error(origin + ": calibration key '" + key + "' holds " + number(m.at<double>(r, c)) + " at (" +
+                            std::to_string(r) + ", " + std::to_string(c) + "); expected finite numbers");
+}
+
+// A camera matrix [fx s cx; 0 fy cy; 0 0 1] with positive focal lengths.
+void checkCameraMatrix(const cv::Mat &M, const char *key, const std::string &origin) {
+    requireFinite(M, key, origin);
+    const double fx = M.at<double>(0, 0), fy = M.at<double>(1, 1);
+    if (!(fx > 0) || !(fy > 0))
+        throw Error(origin + ": calibration key '" + key + "': focal lengths fx = " + number(fx) + ", fy = " + number(fy) +
+                    " px; expected both > 0");
+    if (M.at<double>(1, 0) != 0 || M.at<double>(2, 0) != 0 || M.at<double>(2, 1) != 0 || M.at<double>(2, 2) != 1)
+        throw Error(origin + ": calibration key '" + key + "': expected a camera matrix [fx 0 cx; 0 fy cy; 0 0 1]");
+}
+
+} // namespace
+
+void StereoCalibration::validate(const std::string &origin) const {
+    checkCameraMatrix(M1, "M1", origin);
+    checkCameraMatrix(M2, "M2", origin);
+    requireFinite(D1, "D1", origin);
+    requireFinite(D2, "D2", origin);
+    requireFinite(R, "R", origin);
+    requireFinite(T, "T", origin);
+    // R must be a rotation: orthonormal with determinant 1 (loosely: files are rounded).
+    const cv::Mat err = R * R.t() - cv::Mat::eye(3, 3, CV_64F);
+    if (cv::norm(err, cv::NORM_INF) > 1e-3 || std::abs(cv::determinant(R) - 1) > 1e-3)
+        throw Error(origin + ": calibration key 'R' is not a rotation matrix (expected R R^T = I, det R = 1)");
+    const double b = baselineMm();
+    if (!(b > 0) || b > kMaxBaselineMm)
+        throw Error(origin + ": calibration key 'T' gives a baseline of " + number(b) + " mm; expected > 0 and <= " +
+                    number(kMaxBaselineMm) + " mm");
+}
+
 StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &origin) {
     cv::FileStorage fs;
     try {
@@ -73,30 +148,37 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
     }
     if (!fs.isOpened()) throw Error(origin + ": not an OpenCV FileStorage YAML calibration (expected '%YAML:1.0' and keys M1, D1, ...)");
     StereoCalibration c;
-    int w = 0, h = 0;
-    fs["image_width"] >> w;
-    fs["image_height"] >> h;
-    if (w <= 0 || h <= 0)
-        throw Error(origin + ": calibration keys image_width/image_height must be positive (got " + std::to_string(w) + "x" +
-                    std::to_string(h) + ")");
-    c.image_size = cv::Size(w, h);
-    c.M1 = readMatrix(fs, "M1", 3, 3, origin);
-    c.M2 = readMatrix(fs, "M2", 3, 3, origin);
-    c.D1 = readMatrix(fs, "D1", 0, 0, origin, false);
-    c.D2 = readMatrix(fs, "D2", 0, 0, origin, false);
-    if (c.D1.empty()) c.D1 = cv::Mat::zeros(1, 5, CV_64F);
-    if (c.D2.empty()) c.D2 = cv::Mat::zeros(1, 5, CV_64F);
-    c.D1 = c.D1.reshape(1, 1);
-    c.D2 = c.D2.reshape(1, 1);
-    c.R = readMatrix(fs, "R", 3, 3, origin);
-    c.T = readMatrix(fs, "T", 3, 1, origin);
-    int rectified = 0;
-    if (!fs["rectified"].empty()) fs["rectified"] >> rectified;
-    c.rectified = rectified != 0;
-    if (!fs["rms_px"].empty()) fs["rms_px"] >> c.rms_px;
-    if (!fs["configuration"].empty()) fs["configuration"] >> c.configuration;
-    if (c.baselineMm() <= 0) throw Error(origin + ": calibration key 'T' gives a zero baseline");
-    c.computeRectification();
+    try {
+        const int w = imageSide(fs, "image_width", origin), h = imageSide(fs, "image_height", origin);
+        c.image_size = cv::Size(w, h);
+        c.M1 = readMatrix(fs, "M1", 3, 3, origin);
+        c.M2 = readMatrix(fs, "M2", 3, 3, origin);
+        c.D1 = readMatrix(fs, "D1", 0, 0, origin, false);
+        c.D2 = readMatrix(fs, "D2", 0, 0, origin, false);
+        if (c.D1.empty()) c.D1 = cv::Mat::zeros(1, 5, CV_64F);
+        if (c.D2.empty()) c.D2 = cv::Mat::zeros(1, 5, CV_64F);
+        c.D1 = c.D1.reshape(1, 1);
+        c.D2 = c.D2.reshape(1, 1);
+        for (const auto &[key, D] : {std::pair<const char *, const cv::Mat *>{"D1", &c.D1}, {"D2", &c.D2}})
+            if (D->cols != 4 && D->cols != 5 && D->cols != 8 && D->cols != 12 && D->cols != 14)
+                throw Error(origin + ": calibration key '" + key + "' holds " + std::to_string(D->cols) +
+                            " coefficients; expected 4, 5, 8, 12 or 14 (OpenCV's distortion models)");
+        c.R = readMatrix(fs, "R", 3, 3, origin);
+        c.T = readMatrix(fs, "T", 3, 1, origin);
+        if (const cv::FileNode r = fs["rectified"]; !r.empty()) {
+            if (!r.isInt() || (r.real() != 0 && r.real() != 1))
+                throw Error(origin + ": calibration key 'rectified' must be 0 or 1");
+            c.rectified = static_cast<int>(r) != 0;
+        }
+        if (const cv::FileNode r = fs["rms_px"]; !r.empty() && (r.isReal() || r.isInt())) c.rms_px = r.real();
+        if (const cv::FileNode n = fs["configuration"]; !n.empty() && n.isString()) c.configuration = n.string();
+        c.validate(origin);
+        c.computeRectification();
+    } catch (const cv::Exception &e) {
+        throw Error(origin + ": calibration cannot be used: " + e.err);
+    }
+    for (const auto &[key, m] : {std::pair<const char *, const cv::Mat *>{"P1", &c.P1}, {"P2", &c.P2}, {"Q", &c.Q}})
+        requireFinite(*m, key, origin + " (after rectification)");
     return c;
 }
 

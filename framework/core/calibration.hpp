@@ -33,6 +33,12 @@ struct StereoCalibration {
     // Fills R1, R2, P1, P2, Q (cv::stereoRectify, CALIB_ZERO_DISPARITY, alpha 0).
     void computeRectification();
 
+    // Throws binocle::Error naming `origin` and the key unless M1, M2 are camera matrices
+    // with positive focal lengths, every value is finite, R is a rotation and the
+    // baseline is > 0 and <= kMaxBaselineMm. fromYaml() calls it.
+    void validate(const std::string &origin) const;
+    static constexpr double kMaxBaselineMm = 1e6; // 1 km: a larger one is a unit mistake
+
     // Parse FileStorage YAML text. `origin` names the file in errors. Throws binocle::Error
     // naming the origin and the key that is missing or malformed.
     static StereoCalibration fromYaml(const std::string &text, const std::string &origin);

@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "input/image_file.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -42,8 +43,12 @@ void writeDisparityPng16(const std::string &path, const cv::Mat &disparity) {
 }
 
 cv::Mat readDisparityPng16(const std::string &path) {
-    cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (raw.empty()) throw Error("cannot read disparity PNG " + path);
+    cv::Mat raw;
+    try {
+        raw = input::readImage(path, cv::IMREAD_UNCHANGED, "disparity PNG");
+    } catch (const input::ImageFileError &e) {
+        throw Error(e.what());
+    }
     if (raw.type() != CV_16U) throw Error(path + ": expected a 16-bit single-channel PNG (KITTI disparity)");
     cv::Mat d;
     raw.convertTo(d, CV_32F, 1.0 / 256.0);
@@ -70,23 +75,26 @@ void writePfm(const std::string &path, const cv::Mat &image) {
 }
 
 cv::Mat readPfm(const std::string &path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error("cannot read PFM " + path);
-    std::string magic;
-    int w = 0, h = 0;
-    double scale = 0;
-    in >> magic >> w >> h >> scale;
-    in.get();
-    if ((magic != "Pf" && magic != "PF") || w <= 0 || h <= 0 || scale == 0)
-        throw Error(path + ": not a PFM file (expected 'Pf' or 'PF', width, height, scale)");
-    const int ch = magic == "PF" ? 3 : 1;
+    // The header is checked against the image limits and the file's size before
+    // anything is allocated: a 20-byte file claiming 65536 x 65536 is refused at once.
+    std::vector<uint8_t> bytes;
+    input::ImageInfo info;
+    std::string problem;
+    try {
+        bytes = input::readImageFileBytes(path, "PFM file");
+    } catch (const input::ImageFileError &e) {
+        throw Error(e.what());
+    }
+    if (!input::inspectImage(bytes.data(), bytes.size(), info, problem)) throw Error("PFM file '" + path + "': " + problem);
+    if (info.format != "pfm") throw Error(path + ": not a PFM file (expected 'Pf' or 'PF', width, height, scale)");
+    const int w = static_cast<int>(info.width), h = static_cast<int>(info.height), ch = info.channels;
     cv::Mat m(h, w, CV_32FC(ch));
-    const bool bigEndian = scale > 0;
-    for (int v = h - 1; v >= 0; --v) {
-        in.read(reinterpret_cast<char *>(m.ptr(v)), static_cast<std::streamsize>(w * ch * sizeof(float)));
-        if (!in) throw Error(path + ": PFM data is truncated");
+    const bool bigEndian = info.scale > 0;
+    const size_t rowBytes = static_cast<size_t>(w) * ch * sizeof(float);
+    for (int v = h - 1, r = 0; v >= 0; --v, ++r) {
+        std::memcpy(m.ptr(v), bytes.data() + info.dataOffset + rowBytes * static_cast<size_t>(r), rowBytes);
         if (bigEndian) {
-            auto *b = reinterpret_cast<unsigned char *>(m.ptr(v));
+            auto *b = m.ptr(v);
             for (int i = 0; i < w * ch; ++i) std::swap(b[4 * i], b[4 * i + 3]), std::swap(b[4 * i + 1], b[4 * i + 2]);
         }
     }

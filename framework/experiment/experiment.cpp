@@ -6,14 +6,20 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+#include "input/yaml_file.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
 #include "method/statistics.hpp"
 #include "pipeline/pipeline.hpp"
 #include "report/chart.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -71,20 +77,37 @@ struct Reader {
     }
     [[noreturn]] void fail(const YAML::Node &n, const std::string &what) const { throw Error(where(n) + ": " + what); }
     void checkKeys(const YAML::Node &map, const std::vector<std::string> &valid, const std::string &what) const {
+        if (!map.IsMap()) fail(map, what + ": expected a map");
         for (const auto &kv : map) {
-            const std::string k = kv.first.as<std::string>();
+            const std::string k = key(kv.first);
             if (std::find(valid.begin(), valid.end(), k) != valid.end()) continue;
             const std::string hint = nearest(k, valid);
             fail(kv.first, what + ": unknown key '" + k + "'" + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
                                " (valid keys: " + join(valid) + ")");
         }
     }
+    // One strict reader of numbers (input/numbers.hpp): decimal, finite.
     double number(const YAML::Node &n, const std::string &what) const {
         double v = 0;
-        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
-            fail(n, what + ": value '" + (n.IsScalar() ? n.Scalar() : std::string("(not a scalar)")) + "' is not a number");
+        std::string why;
+        if (!n.IsScalar() || !input::parseReal(n.Scalar(), v, &why))
+            fail(n, what + ": value '" + (n.IsScalar() ? input::printable(n.Scalar()) : std::string("(not a scalar)")) +
+                        "' is not valid: " + (why.empty() ? "expected a number" : why));
         return v;
     }
+    // A whole number in [min, max], checked before the cast.
+    int64_t integer(const YAML::Node &n, const std::string &what, int64_t min, int64_t max) const {
+        const double v = number(n, what);
+        if (!(v >= static_cast<double>(min) && v <= static_cast<double>(max)) || v != std::floor(v))
+            fail(n, what + ": value '" + n.Scalar() + "' is not valid: expected a whole number " + std::to_string(min) +
+                        ".." + std::to_string(max));
+        return static_cast<int64_t>(v);
+    }
+    std::string text(const YAML::Node &n, const std::string &what) const {
+        if (!n.IsScalar()) fail(n, what + ": expected a text, not " + (n.IsMap() ? "a map" : n.IsSequence() ? "a list" : "nothing"));
+        return n.Scalar();
+    }
+    static std::string key(const YAML::Node &k) { return k.IsScalar() ? k.Scalar() : "(a non-scalar key)"; }
     std::vector<double> numbers(const YAML::Node &n, const std::string &what) const {
         if (!n.IsSequence()) fail(n, what + ": expected a list of numbers, e.g. [2.8, 4, 8]");
         std::vector<double> out;
@@ -264,10 +287,9 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
     Reader r{e.file};
     YAML::Node root;
     try {
-        root = YAML::LoadFile(e.file);
-    } catch (const YAML::ParserException &x) {
-        throw Error(e.file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
-                    ": YAML syntax error: " + x.msg);
+        root = input::loadYamlFile(e.file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
     if (!root.IsMap()) throw Error(e.file + ": expected a map with rig:, tests: ...");
     for (const auto &text : overrides) {
@@ -281,19 +303,19 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         applyOverride(root, o);
     }
     r.checkKeys(root, kTopKeys, "experiment");
-    e.name = root["name"] ? root["name"].as<std::string>() : fs::path(e.file).stem().string();
-    e.description = root["description"] ? root["description"].as<std::string>() : "";
+    e.name = root["name"] ? r.text(root["name"], "name") : fs::path(e.file).stem().string();
+    e.description = root["description"] ? r.text(root["description"], "description") : "";
     if (!root["rig"] || !root["rig"].IsScalar()) throw Error(e.file + ": missing key 'rig' (the base rig file)");
     fs::path rigPath = root["rig"].Scalar();
     if (rigPath.is_relative()) rigPath = fs::path(e.file).parent_path() / rigPath;
     e.rig_file = rigPath.lexically_normal().string();
     if (!fs::exists(e.rig_file)) r.fail(root["rig"], "rig: file '" + e.rig_file + "' does not exist");
     try {
-        e.rig = YAML::LoadFile(e.rig_file);
-    } catch (const YAML::ParserException &x) {
-        throw Error(e.rig_file + ":" + std::to_string(x.mark.line + 1) + ":" + std::to_string(x.mark.column + 1) +
-                    ": YAML syntax error: " + x.msg);
+        e.rig = input::loadYamlFile(e.rig_file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
+    if (!e.rig.IsMap()) throw Error(e.rig_file + ": expected a YAML map with source, matcher, ... at the top level");
     // rig_set: a partial rig laid over the base rig for every test (variants of a whole
     // experiment: `--set rig_set.source.image_width=640`).
     if (YAML::Node rs = root["rig_set"]) {
@@ -307,11 +329,7 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         };
         lay(rs, "");
     }
-    if (root["frames"]) {
-        const double f = r.number(root["frames"], "frames");
-        if (f < 1 || f != std::floor(f)) r.fail(root["frames"], "frames: expected a whole number >= 1");
-        e.frames = static_cast<int64_t>(f);
-    }
+    if (root["frames"]) e.frames = r.integer(root["frames"], "frames", 1, 1000000);
     if (root["lenses_mm"]) e.lenses_mm = r.numbers(root["lenses_mm"], "lenses_mm");
     if (root["baseline_range_mm"]) {
         auto b = r.numbers(root["baseline_range_mm"], "baseline_range_mm");
@@ -323,10 +341,15 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
     // defaults (a simulated head); a source that states none gets no sensor-aware columns.
     e.pixel_pitch_um = root["pixel_pitch_um"] ? r.number(root["pixel_pitch_um"], "pixel_pitch_um")
                                               : sourceFigure(e.rig, "pixel_pitch_um", host);
-    e.image_width_px = static_cast<int>(root["image_width_px"] ? r.number(root["image_width_px"], "image_width_px")
-                                                               : sourceFigure(e.rig, "image_width", host));
+    constexpr int64_t kMaxWidth = 32768;
+    if (root["image_width_px"]) {
+        e.image_width_px = static_cast<int>(r.integer(root["image_width_px"], "image_width_px", 1, kMaxWidth));
+    } else {
+        const double w = sourceFigure(e.rig, "image_width", host);
+        e.image_width_px = std::isfinite(w) && w >= 1 && w <= kMaxWidth ? static_cast<int>(w) : 0;
+    }
 
-    if (root["image_height_px"]) e.image_height_px = static_cast<int>(r.number(root["image_height_px"], "image_height_px"));
+    if (root["image_height_px"]) e.image_height_px = static_cast<int>(r.integer(root["image_height_px"], "image_height_px", 1, kMaxWidth));
     else if (e.rig["source"] && e.rig["source"]["image_height"]) e.image_height_px = e.rig["source"]["image_height"].as<int>();
     if (YAML::Node d = root["disparity_search_px"]) {
         auto v = r.numbers(d, "disparity_search_px");
@@ -434,12 +457,13 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         if (!b.IsMap()) r.fail(b, "bind: expected a map variable -> list of rig paths");
         r.checkKeys(b, kVariables, "bind");
         for (const auto &kv : b) {
+            const std::string var = Reader::key(kv.first);
             std::vector<std::string> paths;
             if (kv.second.IsScalar()) paths.push_back(kv.second.Scalar());
             else if (kv.second.IsSequence())
-                for (const auto &p : kv.second) paths.push_back(p.as<std::string>());
-            else r.fail(kv.second, "bind." + kv.first.as<std::string>() + ": expected a rig path or a list of them");
-            e.bind[kv.first.as<std::string>()] = paths;
+                for (const auto &p : kv.second) paths.push_back(r.text(p, "bind." + var));
+            else r.fail(kv.second, "bind." + var + ": expected a rig path or a list of them");
+            e.bind[var] = paths;
         }
     }
     // Defaults of the variables: the experiment's `defaults:`, else the base rig's values.
@@ -456,10 +480,15 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
                 found = false;
                 break;
             }
-            n = n.IsSequence() ? n[std::stoul(part)] : n[part];
+            int64_t index = 0;
+            if (n.IsSequence() && !input::parseInteger(part, index, nullptr, 0, static_cast<int64_t>(n.size()) - 1)) {
+                found = false;
+                break;
+            }
+            n = n.IsSequence() ? n[static_cast<size_t>(index)] : n[part];
         }
         double v = 0;
-        if (found && n.IsDefined() && n.IsScalar() && YAML::convert<double>::decode(n, v)) {
+        if (found && n.IsDefined() && n.IsScalar() && input::parseReal(n.Scalar(), v)) {
             *field(defaults, var) = v;
             haveDefault.insert(var);
         }
@@ -468,8 +497,9 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         if (!d.IsMap()) r.fail(d, "defaults: expected a map of variables");
         r.checkKeys(d, kVariables, "defaults");
         for (const auto &kv : d) {
-            *field(defaults, kv.first.as<std::string>()) = r.number(kv.second, "defaults." + kv.first.as<std::string>());
-            haveDefault.insert(kv.first.as<std::string>());
+            const std::string var = Reader::key(kv.first);
+            *field(defaults, var) = r.number(kv.second, "defaults." + var);
+            haveDefault.insert(var);
         }
     }
 
@@ -481,8 +511,12 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         if (!tn.IsMap()) r.fail(tn, "tests[" + std::to_string(i) + "]: expected a map (id, baseline_mm, focal_length_mm, range_mm, ...)");
         r.checkKeys(tn, kTestKeys, "tests[" + std::to_string(i) + "]");
         ExperimentTest t;
-        t.id = tn["id"] ? tn["id"].as<std::string>() : std::to_string(i + 1);
+        t.id = tn["id"] ? r.text(tn["id"], "tests[" + std::to_string(i) + "].id") : std::to_string(i + 1);
         t.line = tn.Mark().line + 1;
+        // The id names the folder test_<id>/ under --out: it must stay a file name.
+        if (std::string why; !input::isSafeName(t.id, &why))
+            r.fail(tn["id"], "tests[" + std::to_string(i) + "].id '" + input::printable(t.id) + "': " + why +
+                                 " (it names the folder test_<id>/ under --out)");
         if (!ids.insert(t.id).second) r.fail(tn, "test " + t.id + ": id used twice");
         t.geometry = defaults;
         for (const auto &var : kVariables) {
@@ -494,7 +528,7 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         }
         if (YAML::Node s = tn["set"]) {
             if (!s.IsMap()) r.fail(s, "test " + t.id + ": set: expected a map of rig paths to values");
-            for (const auto &kv : s) t.set.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+            for (const auto &kv : s) t.set.emplace_back(r.text(kv.first, "test " + t.id + ": set"), yamlText(kv.second));
         }
         if (tn["repeats"]) t.repeats = static_cast<int>(wholeNumber(tn["repeats"], "test " + t.id + ": repeats", 1, 10000));
         if (YAML::Node pp = tn["paper"]) {
@@ -522,13 +556,17 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         for (const auto &cn : c) {
             r.checkKeys(cn, {"type", "metric", "x", "title", "file", "reference_lines"}, "charts");
             ChartSpec s;
-            s.type = cn["type"] ? cn["type"].as<std::string>() : "bars";
+            s.type = cn["type"] ? r.text(cn["type"], "charts.type") : "bars";
             if (s.type != "bars" && s.type != "scatter") r.fail(cn["type"], "charts: type '" + s.type + "': expected bars or scatter");
             if (!cn["metric"]) r.fail(cn, "charts: missing key 'metric' (e.g. eta_3d_percent)");
-            s.metric = cn["metric"].as<std::string>();
-            if (cn["x"]) s.x = cn["x"].as<std::string>();
-            s.title = cn["title"] ? cn["title"].as<std::string>() : "";
-            s.file = cn["file"] ? cn["file"].as<std::string>() : s.metric + (s.type == "scatter" ? "_vs_" + s.x : "");
+            s.metric = r.text(cn["metric"], "charts.metric");
+            if (cn["x"]) s.x = r.text(cn["x"], "charts.x");
+            s.title = cn["title"] ? r.text(cn["title"], "charts.title") : "";
+            s.file = cn["file"] ? r.text(cn["file"], "charts.file") : s.metric + (s.type == "scatter" ? "_vs_" + s.x : "");
+            // The chart is written as <--out>/<file>.png|svg: a file name, not a path.
+            if (std::string why; !input::isSafeName(s.file, &why))
+                r.fail(cn["file"] ? cn["file"] : cn, "charts.file '" + input::printable(s.file) + "': " + why +
+                                                         " (the chart's file name under --out, without extension)");
             if (cn["reference_lines"]) s.reference_lines = r.numbers(cn["reference_lines"], "charts.reference_lines");
             e.charts.push_back(s);
         }
@@ -550,9 +588,9 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     e.rig_file = fs::absolute(rig_file, ec).lexically_normal().string();
     if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
     try {
-        e.rig = YAML::LoadFile(e.rig_file);
-    } catch (const YAML::Exception &x) {
-        throw Error(e.rig_file + ": cannot read YAML: " + x.msg);
+        e.rig = input::loadYamlFile(e.rig_file);
+    } catch (const input::YamlError &x) {
+        throw Error(x.what());
     }
     e.bind = defaultBind(e.rig, host);
     for (size_t i = 0; i < tests.size(); ++i) {
@@ -1050,6 +1088,17 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     }
     if (selected.empty() && (options.shard_count == 1 || !options.only.empty()))
         throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
+    // A partial run (--tests, or a shard) into a folder that already holds this or another
+    // experiment's table would replace it with fewer rows: refused, nothing is touched.
+    if (selected.size() < e.tests.size()) {
+        const fs::path existing = fs::path(options.out_dir) / "results.json";
+        if (fs::exists(existing, ec))
+            throw Error("--out " + options.out_dir + " already holds results (" + existing.string() +
+                        "); a partial run (--tests or --shard) would replace that table with " +
+                        std::to_string(selected.size()) + " of " + std::to_string(e.tests.size()) +
+                        " tests: run into a new folder and join them with `binocle experiment merge OUT DIR...`, "
+                        "or run every test");
+    }
     const TablesMeta meta = metaOf(e, options.shard_index, options.shard_count);
 
     std::vector<Row> rows;

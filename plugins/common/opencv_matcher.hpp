@@ -12,6 +12,7 @@
 #include <binocle/plugin.hpp>
 
 #include <cstdint>
+#include <new>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -155,7 +156,14 @@ public:
                              name_ + ": min_disparity + num_disparities = " + std::to_string(minDisparity + numDisparities) +
                                  ": expected less than the image width " + std::to_string(left.width));
         checkImageSize(left.width, left.height);
-        stereo_->compute(greyView(left, greyLeft_), greyView(right, greyRight_), fixed_);
+        try {
+            stereo_->compute(greyView(left, greyLeft_), greyView(right, greyRight_), fixed_);
+        } catch (const cv::Exception &e) {
+            throw sdk::Error(BINOCLE_ERR_INTERNAL, name_ + ": OpenCV failed on a " + sizeText(left) + " pair: " + e.err);
+        } catch (const std::bad_alloc &) {
+            throw sdk::Error(BINOCLE_ERR_INTERNAL, name_ + ": out of memory matching a " + sizeText(left) + " pair with num_disparities " +
+                                                       std::to_string(numDisparities));
+        }
         cv::Mat out = wrapImage(disparity);
         writeDisparity(fixed_, minDisparity, out);
     }

@@ -6,6 +6,10 @@
 // calibration), the four layouts and their detection, the source itself, and the
 // registration line at the very end. The file formats are described in README.md.
 #include "replay_files.hpp"
+#include "replay_metadata.hpp"
+
+#include "input/image_file.hpp"
+#include "input/text.hpp"
 
 #include <binocle/plugin.hpp>
 
@@ -107,8 +111,9 @@ Settings readSettings(const sdk::Params &p) {
         refuse("ground_truth_scale " + std::to_string(s.groundTruthScale) + ": expected a number > 0");
     if (s.firstFrame < 0) refuse("first_frame " + std::to_string(s.firstFrame) + ": expected >= 0");
     if (s.maxFrames < 0) refuse("max_frames " + std::to_string(s.maxFrames) + ": expected >= 0 (0 = all)");
-    if (!(s.rateHz >= 0) || !std::isfinite(s.rateHz))
-        refuse("rate_hz " + std::to_string(s.rateHz) + ": expected a number >= 0 (0 = as fast as possible)");
+    // Below 1 mHz the frame period (ns) would not fit 64 bits.
+    if (!(s.rateHz >= 0) || !std::isfinite(s.rateHz) || (s.rateHz > 0 && s.rateHz < 1e-3))
+        refuse("rate_hz " + std::to_string(s.rateHz) + ": expected 0 (as fast as possible) or a rate >= 0.001 Hz");
     return s;
 }
 
@@ -196,18 +201,42 @@ std::string publishFirst(const std::vector<std::pair<fs::path, PinholePair>> &ca
     return calibrations.front().second.toYaml();
 }
 
+// Metadata files are small; a folder or a huge file given in their place is refused
+// here rather than read (std::ifstream on a folder throws "basic_filebuf::underflow").
+constexpr uintmax_t kMaxMetadataBytes = uintmax_t{16} << 20;
+
 std::string readText(const fs::path &path, const std::string &what) {
+    std::error_code ec;
+    const auto status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read " + what + " " + inQuotes(path) + ": no such file");
+    if (!fs::is_regular_file(status))
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " is not a regular file");
+    const uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > kMaxMetadataBytes)
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " holds " +
+                                                      std::to_string(size) + " bytes; expected at most " +
+                                                      std::to_string(kMaxMetadataBytes));
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read " + what + " " + inQuotes(path));
+    if (!in) throw Error(BINOCLE_ERR_IO, "replay: cannot read " + what + " " + inQuotes(path) + ": " + std::strerror(errno));
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
 }
 
+// An image file's size from its header when the format is one input::inspectImage
+// reads, else from decoding it.
 cv::Size imageSizeOf(const fs::path &path) {
-    cv::Mat m = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-    if (m.empty()) throw Error(BINOCLE_ERR_IO, "replay: cannot decode image " + inQuotes(path));
-    return m.size();
+    try {
+        const auto bytes = input::readImageFileBytes(path.string(), "image");
+        input::ImageInfo info;
+        std::string problem;
+        if (!input::inspectImage(bytes.data(), bytes.size(), info, problem))
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: image " + inQuotes(path) + ": " + problem);
+        if (!info.format.empty()) return cv::Size(static_cast<int>(info.width), static_cast<int>(info.height));
+        return input::readImage(path.string(), cv::IMREAD_UNCHANGED).size();
+    } catch (const input::ImageFileError &e) {
+        throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
+    }
 }
 
 bool isImageFile(const fs::path &p) {
@@ -215,17 +244,6 @@ bool isImageFile(const fs::path &p) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     static const std::vector<std::string> known{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".pfm", ".webp"};
     return std::find(known.begin(), known.end(), ext) != known.end();
-}
-
-std::vector<double> numbersIn(std::string text) {
-    for (char &c : text)
-        if (c == '[' || c == ']' || c == ';' || c == ',') c = ' ';
-    std::istringstream in(text);
-    std::vector<double> out;
-    double v;
-    while (in >> v) out.push_back(v);
-    if (!in.eof()) out.clear(); // something that is not a number
-    return out;
 }
 
 // ---- glob layout ---------------------------------------------------------------------------
@@ -277,63 +295,16 @@ Plan planGlob(const Settings &s) {
 
 bool isMiddleburyScene(const fs::path &folder) { return fs::is_regular_file(folder / "im0.png"); }
 
-// calib.txt: lines key=value; cam0=[f 0 cx; 0 f cy; 0 0 1], cam1, doffs, baseline (mm),
-// width, height, ndisp ...
+// calib.txt: see replay_metadata.hpp.
 PinholePair readMiddleburyCalib(const fs::path &file, const fs::path &leftImage,
                                 std::vector<std::pair<std::string, std::string>> &facts) {
-    std::ifstream in(file);
-    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read Middlebury calibration " + inQuotes(file));
-    std::map<std::string, std::pair<std::vector<double>, int>> values; // key -> numbers, line
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        auto eq = line.find('=');
-        if (line.find_first_not_of(" \t") == std::string::npos) continue;
-        if (eq == std::string::npos)
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + file.string() + ":" + std::to_string(number) + ": '" +
-                                                          line + "': expected key=value");
-        std::string key = line.substr(0, eq);
-        key.erase(key.find_last_not_of(" \t") + 1);
-        key.erase(0, key.find_first_not_of(" \t"));
-        values[key] = {numbersIn(line.substr(eq + 1)), number};
-    }
-    auto numbers = [&](const std::string &key, size_t count, bool required) -> std::vector<double> {
-        auto it = values.find(key);
-        if (it == values.end()) {
-            if (required)
-                throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                            "replay: Middlebury calibration " + inQuotes(file) + " has no '" + key + "' line");
-            return {};
-        }
-        if (it->second.first.size() != count)
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + file.string() + ":" + std::to_string(it->second.second) +
-                                                          ": '" + key + "' holds " + std::to_string(it->second.first.size()) +
-                                                          " numbers; expected " + std::to_string(count));
-        return it->second.first;
-    };
-    const auto cam0 = numbers("cam0", 9, true);
-    const auto cam1 = numbers("cam1", 9, true);
-    const auto baseline = numbers("baseline", 1, true);
-    const auto width = numbers("width", 1, false);
-    const auto height = numbers("height", 1, false);
-    if (!(baseline[0] > 0) || !(cam0[0] > 0) || !(cam1[0] > 0))
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: Middlebury calibration " + inQuotes(file) +
-                                                      ": expected a positive baseline and focal lengths");
+    const MiddleburyCalib c = parseMiddleburyCalib(readText(file, "Middlebury calibration"), file.string());
     PinholePair pair;
-    pair.M1 = cv::Matx33d(cam0.data());
-    pair.M2 = cv::Matx33d(cam1.data());
-    pair.baselineMm = baseline[0];
-    pair.imageSize = !width.empty() && !height.empty()
-                         ? cv::Size(static_cast<int>(width[0]), static_cast<int>(height[0]))
-                         : imageSizeOf(leftImage);
-    for (const char *key : {"ndisp", "doffs", "vmin", "vmax"}) {
-        auto v = numbers(key, 1, false);
-        if (!v.empty()) {
-            std::ostringstream s;
-            s << v[0];
-            facts.emplace_back(key, s.str());
-        }
-    }
+    pair.M1 = cv::Matx33d(c.cam0.data());
+    pair.M2 = cv::Matx33d(c.cam1.data());
+    pair.baselineMm = c.baselineMm;
+    pair.imageSize = c.width > 0 ? cv::Size(c.width, c.height) : imageSizeOf(leftImage);
+    facts.insert(facts.end(), c.facts.begin(), c.facts.end());
     return pair;
 }
 
@@ -410,46 +381,15 @@ bool kittiCameras(const fs::path &folder, KittiCameras &out) {
     return false;
 }
 
-// Reads "KEY: numbers" lines; the projection of camera i is "P<i>" or "P_rect_0<i>".
+// "KEY: numbers" lines, see replay_metadata.hpp; false when the file has no projection
+// for the pair's cameras.
 bool readKittiCalib(const fs::path &file, const KittiCameras &cams, const fs::path &leftImage, PinholePair &out) {
-    std::ifstream in(file);
-    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read KITTI calibration " + inQuotes(file));
-    std::map<std::string, std::vector<double>> values;
-    std::string line;
-    while (std::getline(in, line)) {
-        auto colon = line.find(':');
-        if (colon == std::string::npos) continue;
-        values[line.substr(0, colon)] = numbersIn(line.substr(colon + 1));
-    }
-    auto projection = [&](int i, cv::Matx34d &P) {
-        for (const std::string &key : {"P" + std::to_string(i), "P_rect_0" + std::to_string(i)}) {
-            auto it = values.find(key);
-            if (it == values.end()) continue;
-            if (it->second.size() != 12)
-                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: KITTI calibration " + inQuotes(file) + ": '" + key +
-                                                              "' holds " + std::to_string(it->second.size()) +
-                                                              " numbers; expected 12 (a 3x4 projection)");
-            P = cv::Matx34d(it->second.data());
-            return true;
-        }
-        return false;
-    };
-    cv::Matx34d PL, PR;
-    if (!projection(cams.leftIndex, PL) || !projection(cams.rightIndex, PR)) return false;
-    out.M1 = PL.get_minor<3, 3>(0, 0);
-    out.M2 = PR.get_minor<3, 3>(0, 0);
-    // P = K [I | t]: t = K^-1 P(:,3) in metres, relative to the rectified camera 0.
-    const cv::Vec3d tl = out.M1.inv() * cv::Vec3d(PL(0, 3), PL(1, 3), PL(2, 3));
-    const cv::Vec3d tr = out.M2.inv() * cv::Vec3d(PR(0, 3), PR(1, 3), PR(2, 3));
-    out.baselineMm = (tl[0] - tr[0]) * 1000.0;
-    if (!(out.baselineMm > 0) || !(out.M1(0, 0) > 0))
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: KITTI calibration " + inQuotes(file) +
-                                                      ": P matrices give a baseline of " + std::to_string(out.baselineMm) +
-                                                      " mm; expected the left camera left of the right one");
-    auto size = values.find("S_rect_0" + std::to_string(cams.leftIndex));
-    out.imageSize = size != values.end() && size->second.size() == 2
-                        ? cv::Size(static_cast<int>(size->second[0]), static_cast<int>(size->second[1]))
-                        : imageSizeOf(leftImage);
+    const auto c = parseKittiCalib(readText(file, "KITTI calibration"), file.string(), cams.leftIndex, cams.rightIndex);
+    if (!c) return false;
+    out.M1 = c->left.get_minor<3, 3>(0, 0);
+    out.M2 = c->right.get_minor<3, 3>(0, 0);
+    out.baselineMm = c->baselineMm;
+    out.imageSize = c->width > 0 ? cv::Size(c->width, c->height) : imageSizeOf(leftImage);
     return true;
 }
 
@@ -524,29 +464,6 @@ Plan planKitti(const Settings &s, const sdk::Host &host) {
 // the folder), calibration.yml, rig.yaml. A recording cut short stays readable up to its
 // last complete frame.
 
-std::vector<std::string> splitCsv(const std::string &line) {
-    std::vector<std::string> fields;
-    std::string field;
-    std::istringstream in(line);
-    while (std::getline(in, field, ',')) fields.push_back(field);
-    if (!line.empty() && line.back() == ',') fields.emplace_back();
-    for (std::string &f : fields) {
-        f.erase(f.find_last_not_of(" \t") + 1);
-        f.erase(0, f.find_first_not_of(" \t"));
-    }
-    return fields;
-}
-
-bool parseInt64(const std::string &text, int64_t &out) {
-    if (text.empty()) return false;
-    char *end = nullptr;
-    errno = 0;
-    long long v = std::strtoll(text.c_str(), &end, 10);
-    if (errno != 0 || end != text.c_str() + text.size()) return false;
-    out = v;
-    return true;
-}
-
 Plan planRecording(const Settings &s, const sdk::Host &host) {
     const fs::path folder = s.folder;
     const fs::path csv = folder / "frames.csv";
@@ -554,73 +471,27 @@ Plan planRecording(const Settings &s, const sdk::Host &host) {
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
     if (!fs::is_regular_file(csv))
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording folder " + inQuotes(folder) + " holds no frames.csv");
-    const std::string text = readText(csv, "recording index");
-
-    // Lines, each with its number and whether a newline ended it.
-    struct Line {
-        std::string text;
-        int number;
-        bool ended;
-    };
-    std::vector<Line> lines;
-    size_t pos = 0;
-    for (int number = 1; pos < text.size(); ++number) {
-        size_t eol = text.find('\n', pos);
-        Line l{text.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos), number, eol != std::string::npos};
-        if (!l.text.empty() && l.text.back() == '\r') l.text.pop_back();
-        if (l.text.find_first_not_of(" \t") != std::string::npos) lines.push_back(std::move(l));
-        pos = eol == std::string::npos ? text.size() : eol + 1;
-    }
     const std::string where = csv.string();
-    if (lines.empty()) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + inQuotes(csv) + " is empty; expected a header line");
-
-    const std::vector<std::string> header = splitCsv(lines.front().text);
-    const char *required[] = {"sequence", "timestamp_left_ns", "timestamp_right_ns", "left", "right"};
-    size_t column[5];
-    for (int c = 0; c < 5; ++c) {
-        auto it = std::find(header.begin(), header.end(), required[c]);
-        if (it == header.end())
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                        "replay: " + where + ":" + std::to_string(lines.front().number) + ": header '" + lines.front().text +
-                            "' has no column '" + required[c] +
-                            "'; expected sequence,timestamp_left_ns,timestamp_right_ns,left,right");
-        column[c] = static_cast<size_t>(it - header.begin());
-    }
+    const RecordingIndex index = parseFramesCsv(readText(csv, "recording index"), where);
 
     Plan plan;
     plan.layout = "recording";
     plan.lenientLastFrame = true;
+    if (!index.droppedLast.empty()) {
+        host.warning("replay: " + index.droppedLast + ": a recording cut short; it is ignored");
+        ++plan.droppedAtEnd;
+    }
     std::vector<int> lineOf;
-    for (size_t i = 1; i < lines.size(); ++i) {
-        const Line &l = lines[i];
-        const bool last = i + 1 == lines.size();
-        const std::vector<std::string> fields = splitCsv(l.text);
-        std::string problem;
-        int64_t sequence = 0;
+    for (const RecordedPair &p : index.pairs) {
         FrameFiles f;
-        if (fields.size() != header.size())
-            problem = std::to_string(fields.size()) + " fields; expected " + std::to_string(header.size());
-        else if (!parseInt64(fields[column[0]], sequence) || !parseInt64(fields[column[1]], f.timestampLeftNs) ||
-                 !parseInt64(fields[column[2]], f.timestampRightNs))
-            problem = "sequence and time stamps must be integers";
-        else if (fields[column[3]].empty() || fields[column[4]].empty())
-            problem = "empty image path";
-        if (!problem.empty()) {
-            if (last) { // the recorder was stopped while writing this line
-                host.warning("replay: " + where + ":" + std::to_string(l.number) + " is incomplete (" + problem +
-                             "): a recording cut short; it is ignored");
-                ++plan.droppedAtEnd;
-                break;
-            }
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                        "replay: " + where + ":" + std::to_string(l.number) + ": '" + l.text + "': " + problem);
-        }
         f.hasTimestamps = true;
-        f.left = folder / fields[column[3]];
-        f.right = folder / fields[column[4]];
-        f.facts.emplace_back("recorded_sequence", std::to_string(sequence));
+        f.timestampLeftNs = p.timestampLeftNs;
+        f.timestampRightNs = p.timestampRightNs;
+        f.left = folder / p.left;
+        f.right = folder / p.right;
+        f.facts.emplace_back("recorded_sequence", std::to_string(p.sequence));
         plan.frames.push_back(std::move(f));
-        lineOf.push_back(l.number);
+        lineOf.push_back(p.line);
     }
     // Images missing at the end: the recorder stopped before writing them.
     while (!plan.frames.empty() &&
@@ -812,24 +683,24 @@ private:
     bool decode(const FrameFiles &files, Pixels &px) {
         // Pixels as stored: the calibration speaks of the sensor's rows, whatever EXIF says.
         const int flags = (settings_.gray ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR) | cv::IMREAD_IGNORE_ORIENTATION;
-        px.left = cv::imread(files.left.string(), flags);
-        px.right = cv::imread(files.right.string(), flags);
+        // Headers are checked before decoding, and a cut-short file is refused rather
+        // than decoded into a partial image (input/image_file.hpp).
         for (const bool isLeft : {true, false}) {
-            const cv::Mat &mat = isLeft ? px.left : px.right;
             const fs::path &path = isLeft ? files.left : files.right;
-            const char *side = isLeft ? "left" : "right";
-            if (!mat.empty()) continue;
-            if (plan_.lenientLastFrame && next_ + 1 == plan_.frames.size()) {
-                host_.warning("replay: cannot decode the last recorded " + std::string(side) + " image " + inQuotes(path) +
-                              ": a recording cut short; the frame is ignored");
-                plan_.frames.pop_back();
-                plan_.lenientLastFrame = false;
-                ++plan_.droppedAtEnd;
-                return false;
+            const std::string side = isLeft ? "left" : "right";
+            try {
+                (isLeft ? px.left : px.right) = input::readImage(path.string(), flags, side + " image");
+            } catch (const input::ImageFileError &e) {
+                if (plan_.lenientLastFrame && next_ + 1 == plan_.frames.size()) {
+                    host_.warning(std::string("replay: cannot use the last recorded frame: ") + e.what() +
+                                  ": a recording cut short; the frame is ignored");
+                    plan_.frames.pop_back();
+                    plan_.lenientLastFrame = false;
+                    ++plan_.droppedAtEnd;
+                    return false;
+                }
+                throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
             }
-            throw Error(fs::exists(path) ? BINOCLE_ERR_IO : BINOCLE_ERR_NOT_FOUND,
-                        "replay: cannot read " + std::string(side) + " image " + inQuotes(path) +
-                            (fs::exists(path) ? ": expected an image file OpenCV can decode" : ": no such file"));
         }
         if (px.left.size() != px.right.size())
             throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: left image " + inQuotes(files.left) + " is " +

@@ -2,6 +2,10 @@
 // File helpers of the replay source: glob patterns, natural order, PFM, disparity ground truth.
 #include "replay_files.hpp"
 
+#include "replay_metadata.hpp"
+
+#include "input/image_file.hpp"
+
 #include <binocle/plugin.hpp>
 
 #include <opencv2/imgcodecs.hpp>
@@ -159,53 +163,30 @@ std::vector<fs::path> listFolder(const fs::path &folder, bool folders) {
 }
 
 cv::Mat readPfm(const fs::path &path) {
-    const std::string name = "'" + path.string() + "'";
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot open PFM file " + name);
-    std::string magic;
-    int width = 0, height = 0;
-    double scale = 0;
-    in >> magic >> width >> height >> scale;
-    if (!in || (magic != "Pf" && magic != "PF") || width <= 0 || height <= 0 || scale == 0 ||
-        width > 1 << 16 || height > 1 << 16)
-        throw Error(BINOCLE_ERR_IO, "replay: " + name +
-                                        " is not a PFM file (expected a header 'Pf' or 'PF', width, height and a non-zero scale)");
-    in.get(); // the single whitespace character that ends the header
-    const int channels = magic == "PF" ? 3 : 1;
-    const size_t rowFloats = static_cast<size_t>(width) * channels;
-    std::vector<float> data(rowFloats * height);
-    const auto bytes = static_cast<std::streamsize>(data.size() * sizeof(float));
-    in.read(reinterpret_cast<char *>(data.data()), bytes);
-    if (in.gcount() != bytes)
-        throw Error(BINOCLE_ERR_IO, "replay: PFM file " + name + " is truncated: " + std::to_string(width) + "x" +
-                                        std::to_string(height) + "x" + std::to_string(channels) + " floats need " +
-                                        std::to_string(bytes) + " bytes, found " + std::to_string(in.gcount()));
-    const uint16_t probe = 1;
-    const bool hostLittle = *reinterpret_cast<const uint8_t *>(&probe) == 1;
-    const bool fileLittle = scale < 0;
-    if (hostLittle != fileLittle) {
-        for (float &v : data) {
-            uint8_t b[4];
-            std::memcpy(b, &v, 4);
-            std::swap(b[0], b[3]);
-            std::swap(b[1], b[2]);
-            std::memcpy(&v, b, 4);
-        }
+    std::vector<uint8_t> bytes;
+    try {
+        bytes = input::readImageFileBytes(path.string(), "PFM file");
+    } catch (const input::ImageFileError &e) {
+        throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
     }
-    cv::Mat out(height, width, CV_32FC(channels));
-    for (int r = 0; r < height; ++r) // the file's first row is the image's bottom row
-        std::memcpy(out.ptr<float>(height - 1 - r), data.data() + rowFloats * r, rowFloats * sizeof(float));
-    return out;
+    return decodePfm(bytes.data(), bytes.size(), path.string());
 }
 
 GroundTruth readGroundTruth(const fs::path &path, double scale) {
     const std::string name = "'" + path.string() + "'";
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    cv::Mat raw = ext == ".pfm" ? readPfm(path) : cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-    if (raw.empty())
-        throw Error(fs::exists(path) ? BINOCLE_ERR_IO : BINOCLE_ERR_NOT_FOUND,
-                    "replay: cannot read ground truth " + name + " (expected a 16-bit PNG (d*256), 8-bit PNG or PFM)");
+    cv::Mat raw;
+    if (ext == ".pfm") {
+        raw = readPfm(path);
+    } else {
+        try {
+            raw = input::readImage(path.string(), cv::IMREAD_UNCHANGED, "ground truth");
+        } catch (const input::ImageFileError &e) {
+            throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO,
+                        std::string("replay: ") + e.what() + " (expected a 16-bit PNG (d*256), 8-bit PNG or PFM)");
+        }
+    }
     if (raw.channels() != 1)
         throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + name + " has " + std::to_string(raw.channels()) +
                                                       " channels; expected a one-channel disparity image");

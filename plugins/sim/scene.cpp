@@ -5,6 +5,9 @@
 
 #include "random.hpp"
 
+#include "input/numbers.hpp"
+#include "input/yaml_file.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
@@ -12,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -39,7 +43,7 @@ public:
     void onlyKeys(const YAML::Node &map, const std::string &what, const std::set<std::string> &allowed) const {
         if (!map.IsMap()) fail(map, what + ": expected a map");
         for (const auto &kv : map) {
-            const std::string key = kv.first.as<std::string>();
+            const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "(a non-scalar key)";
             if (!allowed.count(key)) {
                 std::string list;
                 for (const auto &a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -63,12 +67,11 @@ public:
     int integer(const YAML::Node &map, const std::string &key, int def, int min, const std::string &what) const {
         const YAML::Node n = map[key];
         if (!n) return def;
-        int v = 0;
-        try {
-            v = n.as<int>();
-        } catch (const YAML::Exception &) {
-            fail(n, what + "." + key + " = '" + text(n) + "': expected an integer");
-        }
+        // The one strict reader (framework/input): decimal, within int, no octal "0640".
+        int64_t parsed = 0;
+        if (!n.IsScalar() || !binocle::input::parseInteger(n.Scalar(), parsed, nullptr, INT32_MIN, INT32_MAX))
+            fail(n, what + "." + key + " = '" + text(n) + "': expected a decimal integer");
+        const int v = static_cast<int>(parsed);
         if (v < min) fail(n, what + "." + key + " = " + std::to_string(v) + ": expected a value >= " + std::to_string(min));
         return v;
     }
@@ -140,12 +143,8 @@ public:
 private:
     double scalar(const YAML::Node &n, const std::string &what) const {
         double v = 0;
-        try {
-            v = n.as<double>();
-        } catch (const YAML::Exception &) {
-            fail(n, what + " = '" + text(n) + "': expected a number");
-        }
-        if (!std::isfinite(v)) fail(n, what + ": expected a finite number");
+        if (!n.IsScalar() || !binocle::input::parseReal(n.Scalar(), v))
+            fail(n, what + " = '" + text(n) + "': expected a finite decimal number");
         return v;
     }
 
@@ -431,10 +430,9 @@ Scene Scene::fromYaml(const std::string &text, const std::string &origin, const 
     Reader reader(origin, baseDir);
     YAML::Node root;
     try {
-        root = YAML::Load(text);
-    } catch (const YAML::ParserException &e) {
-        throw SceneError(origin + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                         ": not valid YAML: " + e.msg);
+        root = binocle::input::parseYaml(text, origin); // duplicate keys, bad UTF-8 refused too
+    } catch (const binocle::input::YamlError &e) {
+        throw SceneError(e.what());
     }
     if (!root.IsMap()) throw SceneError(origin + ": a scene must be a YAML map (keys name, ground, objects ...)");
     Scene scene;

@@ -24,6 +24,7 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace binocle::videre1394 {
 
@@ -121,8 +122,29 @@ std::string guidText(uint64_t guid) {
 
 // ---- Splitting -------------------------------------------------------------------------------
 
+std::string interleavedFrameProblem(uint32_t width, uint32_t height, uint32_t stride, uint32_t bitsPerPixel,
+                                    uint64_t imageBytes, int decimation) {
+    const std::string geometry = std::to_string(width) + "x" + std::to_string(height) + " frame of " +
+                                 std::to_string(bitsPerPixel) + "-bit pixels, stride " + std::to_string(stride) + ", " +
+                                 std::to_string(imageBytes) + " bytes";
+    if (bitsPerPixel != 16) return geometry + ": expected 16-bit pixels (left and right bytes interleaved)";
+    if (width == 0 || height == 0 || width > 32768 || height > 32768)
+        return geometry + ": expected 1..32768 pixels a side";
+    if (stride < 2ull * width) return geometry + ": the stride is shorter than a row of 2 x width bytes";
+    const uint64_t need = static_cast<uint64_t>(stride) * (height - 1) + 2ull * width;
+    if (imageBytes < need) return geometry + ": its rows need " + std::to_string(need) + " bytes";
+    if (decimation < 1 || decimation > 8 || width % static_cast<uint32_t>(decimation) != 0 ||
+        height % static_cast<uint32_t>(decimation) != 0)
+        return geometry + ": decimation " + std::to_string(decimation) + " must be 1..8 and divide width and height";
+    return "";
+}
+
 void splitInterleaved(uint8_t *image, uint32_t width, uint32_t height, uint32_t stride, int decimation,
                       bool leftIsFirstByte, std::vector<uint8_t> &scratch) {
+    // Callers check first; a frame that slips through must not be read past its end.
+    const uint64_t bytes = static_cast<uint64_t>(stride) * (height ? height - 1 : 0) + 2ull * width;
+    if (const std::string problem = interleavedFrameProblem(width, height, stride, 16, bytes, decimation); !problem.empty())
+        throw std::invalid_argument("videre1394: cannot split a " + problem);
     const size_t plane = static_cast<size_t>(width) * height;
     scratch.resize(2 * plane + 2 * static_cast<size_t>(width));
     uint8_t *first = scratch.data(), *second = scratch.data() + plane;
@@ -467,8 +489,8 @@ std::unique_ptr<sdk::Frame> VidereSource::grab(int32_t timeout_ms) {
 
     // A frame of another size or depth than the mode's cannot be split: give it back.
     const uint64_t need = static_cast<uint64_t>(mode_.width) * mode_.height * 2;
-    if (f.width != mode_.width || f.height != mode_.height || f.bitsPerPixel != 16 || f.stride < 2 * f.width ||
-        f.imageBytes < need) {
+    if (f.width != mode_.width || f.height != mode_.height ||
+        !interleavedFrameProblem(f.width, f.height, f.stride, f.bitsPerPixel, f.imageBytes, settings_.decimation).empty()) {
         std::lock_guard<std::mutex> lock(c.mutex);
         try {
             c.camera().enqueue(f);

@@ -36,6 +36,14 @@ struct Settings {
 void splitInterleaved(uint8_t *image, uint32_t width, uint32_t height, uint32_t stride, int decimation,
                       bool leftIsFirstByte, std::vector<uint8_t> &scratch);
 
+// Why a frame of this geometry cannot be split in a buffer of imageBytes, or "" when it
+// can: 16-bit pixels, a positive size, stride >= 2 x width, every row inside the buffer
+// (stride x (height - 1) + 2 x width bytes) and a decimation 1..8 dividing both sides.
+// splitInterleaved() throws std::invalid_argument with this text; the source checks
+// each frame with it first.
+std::string interleavedFrameProblem(uint32_t width, uint32_t height, uint32_t stride, uint32_t bitsPerPixel,
+                                    uint64_t imageBytes, int decimation);
+
 // "0x00b09d0100a1b2c3".
 std::string guidText(uint64_t guid);
 

@@ -128,6 +128,28 @@ TEST(Experiment, RunWritesTablesChartsAndPerTestOutputs) {
     EXPECT_TRUE(std::filesystem::exists(dir.str("out/test_b/summary.json")));
 }
 
+TEST(Experiment, APartialRerunIntoAFolderWithResultsIsRefused) {
+    TempDir dir;
+    const std::string file = dir.str("three.yaml");
+    writeText(file, experimentText("  - {id: a, range_mm: 6000, baseline_mm: 100, focal_length_mm: 8}\n"
+                                   "  - {id: b, range_mm: 6000, baseline_mm: 150, focal_length_mm: 8}\n"
+                                   "  - {id: c, range_mm: 12000, baseline_mm: 190, focal_length_mm: 12}\n"));
+    auto r = runCli("experiment " + file + " --quiet --out " + dir.str("out"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string before = readTextFile(dir.str("out/results.csv"));
+    const std::string beforeJson = readTextFile(dir.str("out/results.json"));
+    // Test b again, into the same folder: refused, the table of three rows stays as it was.
+    r = runCli("experiment " + file + " --quiet --tests b --out " + dir.str("out"));
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("a partial run (--tests or --shard) would replace that table with 1 of 3 tests"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(readTextFile(dir.str("out/results.csv")), before);
+    EXPECT_EQ(readTextFile(dir.str("out/results.json")), beforeJson);
+    // Into a fresh folder it runs.
+    r = runCli("experiment " + file + " --quiet --tests b --out " + dir.str("out-b"));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
 TEST(Design, RanksByFormFactorAndRefusesBadInput) {
     TempDir dir;
     auto r = runCli("design --range 6000 --lenses 2.8,8,16 --baselines 100,150 --top 3 --out " + dir.str());

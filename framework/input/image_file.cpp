@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: MIT
+// Image headers checked before decoding; truncated files refused.
+#include "input/image_file.hpp"
+
+#include "input/numbers.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace binocle::input {
+
+namespace {
+
+uint32_t be32(const uint8_t *p) {
+    return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | uint32_t{p[3]};
+}
+uint16_t be16(const uint8_t *p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
+uint32_t le32(const uint8_t *p) {
+    return uint32_t{p[0]} | (uint32_t{p[1]} << 8) | (uint32_t{p[2]} << 16) | (uint32_t{p[3]} << 24);
+}
+uint16_t le16(const uint8_t *p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
+
+bool fail(std::string &problem, const std::string &what) {
+    problem = what;
+    return false;
+}
+
+bool checkSize(const ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    const std::string claim = "header claims " + std::to_string(info.width) + "x" + std::to_string(info.height) + " pixels";
+    if (info.width <= 0 || info.height <= 0) return fail(problem, claim + "; expected a positive size");
+    if (info.width > limits.maxSide || info.height > limits.maxSide)
+        return fail(problem, claim + "; the limit is " + std::to_string(limits.maxSide) + " pixels a side");
+    if (info.width * info.height > limits.maxPixels)
+        return fail(problem, claim + "; the limit is " + std::to_string(limits.maxPixels) + " pixels in all");
+    return true;
+}
+
+bool inspectPng(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    info.format = "png";
+    size_t pos = 8;
+    bool sawHeader = false, sawData = false;
+    while (true) {
+        if (pos + 12 > size)
+            return fail(problem, "PNG ends at byte " + std::to_string(size) + " without its IEND chunk: the file is cut short");
+        const uint32_t length = be32(d + pos);
+        const std::string type(reinterpret_cast<const char *>(d + pos + 4), 4);
+        if (length > 0x7FFFFFFFu) return fail(problem, "PNG chunk '" + type + "' claims " + std::to_string(length) + " bytes");
+        if (pos + 12 + length > size)
+            return fail(problem, "PNG chunk '" + type + "' at byte " + std::to_string(pos) + " needs " +
+                                     std::to_string(length) + " bytes but the file ends at " + std::to_string(size) +
+                                     ": the file is cut short");
+        const uint8_t *body = d + pos + 8;
+        if (!sawHeader) {
+            if (type != "IHDR" || length != 13) return fail(problem, "PNG does not start with its IHDR chunk");
+            sawHeader = true;
+            info.width = be32(body);
+            info.height = be32(body + 4);
+            const uint8_t colour = body[9];
+            info.channels = colour == 0 ? 1 : colour == 2 ? 3 : colour == 3 ? 3 : colour == 4 ? 2 : colour == 6 ? 4 : 0;
+            if (!checkSize(info, problem, limits)) return false;
+        } else if (type == "IDAT") {
+            sawData = true;
+        } else if (type == "IEND") {
+            if (!sawData) return fail(problem, "PNG has no IDAT chunk (no pixel data)");
+            return true;
+        }
+        pos += 12 + length;
+    }
+}
+
+bool inspectJpeg(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    info.format = "jpeg";
+    const std::string cut = "JPEG ends at byte " + std::to_string(size) + " without its end-of-image marker: the file is cut short";
+    size_t pos = 2;
+    bool sawFrame = false;
+    while (true) {
+        // A marker: 0xFF (fill bytes may repeat it) then the code.
+        if (pos >= size) return fail(problem, cut);
+        if (d[pos] != 0xFF) return fail(problem, "JPEG: expected a marker at byte " + std::to_string(pos));
+        while (pos < size && d[pos] == 0xFF) ++pos;
+        if (pos >= size) return fail(problem, cut);
+        const uint8_t marker = d[pos++];
+        if (marker == 0xD9) {
+            if (!sawFrame) return fail(problem, "JPEG has no frame header (SOF)");
+            return true;
+        }
+        if ((marker >= 0xD0 && marker <= 0xD7) || marker == 0x01) continue; // no length
+        if (pos + 2 > size) return fail(problem, cut);
+        const size_t length = be16(d + pos);
+        if (length < 2) return fail(problem, "JPEG segment at byte " + std::to_string(pos) + " has a length below 2");
+        if (pos + length > size) return fail(problem, cut);
+        const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+        if (frame && !sawFrame) {
+            if (length < 8) return fail(problem, "JPEG frame header is too short");
+            info.height = be16(d + pos + 3);
+            info.width = be16(d + pos + 5);
+            info.channels = d[pos + 7];
+            if (info.height == 0) return fail(problem, "JPEG frame header gives a height of 0 (defined later by DNL): not supported");
+            if (!checkSize(info, problem, limits)) return false;
+            sawFrame = true;
+        }
+        pos += length;
+        if (marker == 0xDA) {
+            // Entropy-coded data up to the next marker that is neither a stuffed 0xFF00
+            // nor a restart marker.
+            while (true) {
+                const void *ff = std::memchr(d + pos, 0xFF, size - pos);
+                if (!ff) return fail(problem, cut);
+                pos = static_cast<size_t>(static_cast<const uint8_t *>(ff) - d);
+                if (pos + 1 >= size) return fail(problem, cut);
+                const uint8_t next = d[pos + 1];
+                if (next == 0x00 || (next >= 0xD0 && next <= 0xD7) || next == 0xFF) {
+                    pos += next == 0xFF ? 1 : 2;
+                    continue;
+                }
+                break;
+            }
+        }
+    }
+}
+
+// Whitespace-separated header tokens of PFM/PNM ("#" comments allowed in PNM).
+struct Tokens {
+    const uint8_t *d;
+    size_t size, pos;
+    bool comments;
+    bool next(std::string &out) {
+        out.clear();
+        while (pos < size) {
+            if (comments && d[pos] == '#') {
+                while (pos < size && d[pos] != '\n') ++pos;
+            } else if (std::isspace(d[pos])) {
+                ++pos;
+            } else {
+                break;
+            }
+        }
+        while (pos < size && !std::isspace(d[pos]) && out.size() < 32) out += static_cast<char>(d[pos++]);
+        return !out.empty() && out.size() < 32;
+    }
+};
+
+bool inspectNetpbm(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    const bool pfm = d[1] == 'f' || d[1] == 'F';
+    info.format = pfm ? "pfm" : "pnm";
+    info.channels = (d[1] == 'F' || d[1] == '6') ? 3 : 1;
+    Tokens t{d, size, 2, !pfm};
+    std::string w, h, third, why;
+    int64_t width = 0, height = 0;
+    if (!t.next(w) || !t.next(h) || !t.next(third))
+        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " header is incomplete: expected width, height and " +
+                                 (pfm ? "scale" : "maximum value"));
+    if (!parseInteger(w, width, &why, 1) || !parseInteger(h, height, &why, 1))
+        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " header: width '" + w + "' and height '" + h +
+                                 "' must be positive decimal integers");
+    info.width = width;
+    info.height = height;
+    if (!checkSize(info, problem, limits)) return false;
+    uint64_t bytesPerSample = 4;
+    if (pfm) {
+        double scale = 0;
+        if (!parseReal(third, scale, &why) || scale == 0)
+            return fail(problem, "PFM header: scale '" + third + "' must be a non-zero decimal number");
+        info.scale = scale;
+    } else {
+        int64_t maxValue = 0;
+        if (!parseInteger(third, maxValue, &why, 1, 65535))
+            return fail(problem, "PGM/PPM header: maximum value '" + third + "' must be 1..65535");
+        bytesPerSample = maxValue > 255 ? 2 : 1;
+    }
+    const size_t dataStart = t.pos + 1; // one whitespace character ends the header
+    info.dataOffset = dataStart;
+    const uint64_t need = static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * info.channels * bytesPerSample;
+    const uint64_t have = size > dataStart ? size - dataStart : 0;
+    if (have < need)
+        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " pixel data is cut short: " + std::to_string(width) +
+                                 "x" + std::to_string(height) + "x" + std::to_string(info.channels) + " samples need " +
+                                 std::to_string(need) + " bytes, the file holds " + std::to_string(have));
+    return true;
+}
+
+bool inspectBmp(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    info.format = "bmp";
+    if (size < 30) return fail(problem, "BMP header is cut short");
+    const uint32_t offset = le32(d + 10);
+    const auto width = static_cast<int32_t>(le32(d + 18));
+    const auto height = static_cast<int32_t>(le32(d + 22));
+    const uint16_t bpp = le16(d + 28);
+    info.width = width;
+    info.height = height == INT32_MIN ? 0 : (height < 0 ? -int64_t{height} : height);
+    info.channels = bpp >= 24 ? 3 : 1;
+    if (!checkSize(info, problem, limits)) return false;
+    const uint32_t compression = size >= 34 ? le32(d + 30) : 0;
+    if (compression == 0 && bpp > 0 && bpp <= 32) { // BI_RGB: rows of known size
+        const uint64_t row = (static_cast<uint64_t>(bpp) * info.width + 31) / 32 * 4;
+        if (offset > size || row * info.height > size - offset)
+            return fail(problem, "BMP pixel data is cut short: " + std::to_string(info.width) + "x" +
+                                     std::to_string(info.height) + " at " + std::to_string(bpp) + " bits need " +
+                                     std::to_string(row * info.height) + " bytes after the header");
+    }
+    return true;
+}
+
+} // namespace
+
+bool inspectImage(const uint8_t *data, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    info = {};
+    problem.clear();
+    static const uint8_t kPng[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+    if (size > static_cast<uint64_t>(limits.maxFileBytes))
+        return fail(problem, "the file holds " + std::to_string(size) + " bytes; the limit is " +
+                                 std::to_string(limits.maxFileBytes));
+    if (size >= 8 && std::memcmp(data, kPng, 8) == 0) return inspectPng(data, size, info, problem, limits);
+    if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) return inspectJpeg(data, size, info, problem, limits);
+    if (size >= 3 && data[0] == 'P' && (data[1] == 'f' || data[1] == 'F' || data[1] == '5' || data[1] == '6') &&
+        std::isspace(data[2]))
+        return inspectNetpbm(data, size, info, problem, limits);
+    if (size >= 2 && data[0] == 'B' && data[1] == 'M') return inspectBmp(data, size, info, problem, limits);
+    return true;
+}
+
+std::vector<uint8_t> readImageFileBytes(const std::string &path, const std::string &what, const ImageLimits &limits) {
+    const std::string name = what + " '" + path + "'";
+    std::error_code ec;
+    const auto status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) throw ImageFileError(name + ": no such file", true);
+    if (!fs::is_regular_file(status)) throw ImageFileError(name + ": not a regular file", false);
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec) throw ImageFileError(name + ": cannot read its size: " + ec.message(), false);
+    if (size > limits.maxFileBytes)
+        throw ImageFileError(name + ": the file holds " + std::to_string(size) + " bytes; the limit is " +
+                                 std::to_string(limits.maxFileBytes),
+                             false);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ImageFileError(name + ": cannot open: " + std::strerror(errno), false);
+    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    in.read(reinterpret_cast<char *>(bytes.data()), static_cast<std::streamsize>(size));
+    if (static_cast<uint64_t>(in.gcount()) != size)
+        throw ImageFileError(name + ": read " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes",
+                             false);
+    return bytes;
+}
+
+cv::Mat readImage(const std::string &path, int flags, const std::string &what, const ImageLimits &limits) {
+    const std::vector<uint8_t> bytes = readImageFileBytes(path, what, limits);
+    const std::string name = what + " '" + path + "'";
+    ImageInfo info;
+    std::string problem;
+    if (!inspectImage(bytes.data(), bytes.size(), info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
+    cv::Mat m;
+    try {
+        m = cv::imdecode(bytes, flags);
+    } catch (const cv::Exception &e) {
+        throw ImageFileError(name + ": cannot decode: " + e.err, false);
+    }
+    if (m.empty())
+        throw ImageFileError(name + ": cannot decode" + (info.format.empty() ? ": not an image format OpenCV reads" : " the " + info.format + " data"), false);
+    return m;
+}
+
+} // namespace binocle::input

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: MIT
+// One YAML loader: UTF-8, syntax and duplicate keys checked, size bounded.
+#include "input/yaml_file.hpp"
+
+#include "input/text.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace binocle::input {
+
+namespace {
+
+std::string at(const std::string &origin, const YAML::Mark &m) {
+    if (m.is_null()) return origin;
+    return origin + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
+}
+
+std::string lineColumn(const YAML::Mark &m) { return std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1); }
+
+} // namespace
+
+void checkDuplicateKeys(const YAML::Node &root, const std::string &origin) {
+    std::vector<YAML::Node> todo{root};
+    std::set<int> seen; // marks (byte offsets) of the collections already checked
+    while (!todo.empty()) {
+        const YAML::Node n = todo.back();
+        todo.pop_back();
+        if (!n.IsMap() && !n.IsSequence()) continue;
+        const YAML::Mark m = n.Mark();
+        if (!m.is_null() && !seen.insert(m.pos).second) continue; // an alias of a node already checked
+        if (n.IsSequence()) {
+            for (const auto &e : n) todo.push_back(e);
+            continue;
+        }
+        std::map<std::string, YAML::Mark> keys;
+        for (const auto &kv : n) {
+            if (kv.first.IsScalar()) {
+                auto [it, fresh] = keys.emplace(kv.first.Scalar(), kv.first.Mark());
+                if (!fresh)
+                    throw YamlError(at(origin, kv.first.Mark()) + ": key '" + printable(kv.first.Scalar()) +
+                                    "' given twice in one map: first at " + lineColumn(it->second) + ", again at " +
+                                    lineColumn(kv.first.Mark()) + "; remove one of them");
+            }
+            todo.push_back(kv.second);
+        }
+    }
+}
+
+YAML::Node parseYaml(const std::string &text, const std::string &origin) {
+    size_t bad = 0;
+    if (!isValidUtf8(text, &bad)) {
+        const size_t lineStart = text.rfind('\n', bad == 0 ? 0 : bad - 1);
+        const size_t line = static_cast<size_t>(std::count(text.begin(), text.begin() + static_cast<long>(bad), '\n')) + 1;
+        const size_t column = bad - (lineStart == std::string::npos || bad == 0 ? 0 : lineStart + 1) + 1;
+        char byte[8];
+        std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(text[bad]));
+        throw YamlError(origin + ":" + std::to_string(line) + ":" + std::to_string(column) + ": byte " + byte +
+                        " is not valid UTF-8; expected a UTF-8 text (YAML files are UTF-8)");
+    }
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::ParserException &e) {
+        throw YamlError(at(origin, e.mark) + ": YAML syntax error: " + e.msg);
+    } catch (const YAML::Exception &e) {
+        throw YamlError(origin + ": cannot read YAML: " + e.msg);
+    }
+    checkDuplicateKeys(root, origin);
+    return root;
+}
+
+YAML::Node loadYamlFile(const std::string &path, uint64_t maxBytes) {
+    std::error_code ec;
+    const auto status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) throw YamlError(path + ": no such file");
+    if (!fs::is_regular_file(status)) throw YamlError(path + ": not a regular file; expected a YAML file");
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec) throw YamlError(path + ": cannot read its size: " + ec.message());
+    if (size > maxBytes)
+        throw YamlError(path + ": the file holds " + std::to_string(size) + " bytes; expected a YAML file of at most " +
+                        std::to_string(maxBytes) + " bytes");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw YamlError(path + ": cannot open: " + std::strerror(errno));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseYaml(text.str(), path);
+}
+
+} // namespace binocle::input

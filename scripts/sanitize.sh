@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The second tree of the test command: clang with AddressSanitizer + UndefinedBehavior
+# Sanitizer (-DBINOCLE_SANITIZE=address,undefined, float-cast-overflow included) and the
+# libFuzzer harnesses (-DBINOCLE_FUZZ=ON), in ./build-sanitize (or
+# $BINOCLE_SANITIZE_BUILD_DIR). Builds only what it runs:
+#   1. the tests labelled "sanitize" (host, config, replay, recorder, pipeline and the
+#      bad-input corpus) under ASan + UBSan, halting on the first finding;
+#   2. each fuzz harness for $BINOCLE_FUZZ_SECONDS seconds (default 20) from its seed
+#      corpus in tests/fuzz/corpus/.
+# A finding fails the step. BINOCLE_SKIP_FUZZ=1 skips 2.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dir="${BINOCLE_SANITIZE_BUILD_DIR:-build-sanitize}"
+seconds="${BINOCLE_FUZZ_SECONDS:-20}"
+jobs="$(nproc)"
+start=$(date +%s)
+# As scripts/build.sh: ccache hashes paths relative to the checkout.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
+if [ ! -f "$dir/build.ninja" ]; then
+  launcher=()
+  if command -v ccache >/dev/null 2>&1; then
+    launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  fi
+  # -O1 -g1: the usual optimisation for sanitizers, and quicker to build than -O2 -g.
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+    -DBINOCLE_SANITIZE=address,undefined -DBINOCLE_FUZZ=ON -DBINOCLE_BUILD_BENCH=OFF \
+    -DBINOCLE_FUZZ_SECONDS="$seconds" "${launcher[@]}"
+fi
+cmake -S . -B "$dir" -DBINOCLE_FUZZ_SECONDS="$seconds" >/dev/null
+# The executables of the labelled tests (tests/CMakeLists.txt collects them).
+mapfile -t targets < <(grep -v '^$' "$dir/sanitize-targets.txt")
+cmake --build "$dir" -j "$jobs" --target binocle "${targets[@]}" binocle_fuzzers
+built=$(date +%s)
+# Leak detection is off: the plugins' libraries (OpenCV's thread pool, GLib, Aravis)
+# keep allocations for the life of the process by design.
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+ctest --test-dir "$dir" -L sanitize --output-on-failure -j "$jobs" --timeout 600
+tested=$(date +%s)
+if [ "${BINOCLE_SKIP_FUZZ:-0}" != 1 ]; then
+  ctest --test-dir "$dir" -L fuzz --output-on-failure -j "$jobs" --timeout 600
+fi
+end=$(date +%s)
+echo "sanitize: build $((built - start)) s, tests under ASan+UBSan $((tested - built)) s, fuzzing $((end - tested)) s"

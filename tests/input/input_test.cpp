@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: MIT
+// framework/input: the strict number reader, UTF-8 and path checks, image header checks
+// and the YAML loader.
+#include "input/image_file.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+#include "input/yaml_file.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+using namespace binocle::input;
+
+namespace {
+
+TEST(Numbers, IntegersAreDecimalWholeAndInRange) {
+    int64_t v = 0;
+    std::string why;
+    EXPECT_TRUE(parseInteger("640", v) && v == 640);
+    EXPECT_TRUE(parseInteger("-7", v) && v == -7);
+    EXPECT_TRUE(parseInteger("+7", v) && v == 7);
+    EXPECT_TRUE(parseInteger("0", v) && v == 0);
+    EXPECT_TRUE(parseInteger("-9223372036854775808", v) && v == INT64_MIN);
+    EXPECT_FALSE(parseInteger("0640", v, &why));
+    EXPECT_NE(why.find("leading zeros"), std::string::npos) << why;
+    for (const char *bad : {"", "-", "0x10", "1e3", "12px", " 3", "3 ", "1.0", "9223372036854775808", "٣"})
+        EXPECT_FALSE(parseInteger(bad, v)) << bad;
+    EXPECT_FALSE(parseInteger("17", v, &why, 0, 16));
+    EXPECT_EQ(why, "expected an integer <= 16");
+}
+
+TEST(Numbers, RealsAreDecimalAndFiniteUnlessAsked) {
+    double v = 0;
+    EXPECT_TRUE(parseReal("1.5", v) && v == 1.5);
+    EXPECT_TRUE(parseReal("-.5", v) && v == -0.5);
+    EXPECT_TRUE(parseReal("1e3", v) && v == 1000);
+    EXPECT_TRUE(parseReal("2.", v) && v == 2);
+    EXPECT_TRUE(parseReal("1e300", v) && v == 1e300);
+    for (const char *bad : {"", ".", "nan", ".nan", "inf", ".inf", "0x1p3", "1e", "1e999", "1,5", " 1", "1.5mm"})
+        EXPECT_FALSE(parseReal(bad, v)) << bad;
+    EXPECT_TRUE(parseReal(".inf", v, nullptr, true) && std::isinf(v));
+    EXPECT_TRUE(parseReal(".nan", v, nullptr, true) && std::isnan(v));
+    EXPECT_FALSE(fitsInt(1e300));
+    EXPECT_FALSE(fitsInt(NAN));
+    EXPECT_TRUE(fitsInt(-2147483648.0));
+    EXPECT_FALSE(fitsInt(2147483648.0));
+    EXPECT_FALSE(fitsInt64(9223372036854775808.0));
+}
+
+TEST(Text, Utf8PathsAndNames) {
+    size_t bad = 0;
+    EXPECT_TRUE(isValidUtf8("η3D, εx"));
+    EXPECT_FALSE(isValidUtf8("r\xffg", &bad));
+    EXPECT_EQ(bad, 1u);
+    EXPECT_FALSE(isValidUtf8("\xC0\xAF"));         // overlong '/'
+    EXPECT_FALSE(isValidUtf8("\xED\xA0\x80"));     // surrogate
+    EXPECT_FALSE(isValidUtf8("\xF4\x90\x80\x80")); // > U+10FFFF
+    EXPECT_EQ(sanitizeUtf8("r\xffg"), "r\xEF\xBF\xBDg");
+    EXPECT_EQ(printable("a\nb\x01"), "a\\nb\\x01");
+    EXPECT_EQ(printable(std::string(100, 'x'), 4), "xxxx... (100 bytes)");
+    EXPECT_TRUE(isConfinedRelativePath("left/000001.png"));
+    EXPECT_TRUE(isConfinedRelativePath("a..b/c"));
+    for (const char *bad : {"", "/etc/passwd", "../x", "a/../../b", "a/..", ".."})
+        EXPECT_FALSE(isConfinedRelativePath(bad)) << bad;
+    EXPECT_TRUE(isSafeName("e1-b150_f8.2"));
+    for (const char *bad : {"", ".", "..", "/x", "a/b", "a b", "../x", ".hidden"}) EXPECT_FALSE(isSafeName(bad)) << bad;
+}
+
+std::vector<uint8_t> encode(const std::string &ext, const cv::Mat &m) {
+    std::vector<uint8_t> out;
+    EXPECT_TRUE(cv::imencode(ext, m, out));
+    return out;
+}
+
+TEST(ImageFile, HeadersGiveTheSizeAndCutFilesAreRefused) {
+    cv::Mat m(48, 64, CV_8UC3);
+    cv::randu(m, 0, 255);
+    for (const char *ext : {".png", ".jpg", ".bmp", ".ppm", ".pgm"}) {
+        const cv::Mat img = std::string(ext) == ".pgm" ? m.reshape(1, 48).colRange(0, 64).clone() : m;
+        const auto bytes = encode(ext, img);
+        ImageInfo info;
+        std::string problem;
+        ASSERT_TRUE(inspectImage(bytes.data(), bytes.size(), info, problem)) << ext << ": " << problem;
+        EXPECT_EQ(info.width, 64) << ext;
+        EXPECT_EQ(info.height, 48) << ext;
+        // Cut short: refused, and the reason says so.
+        ASSERT_FALSE(inspectImage(bytes.data(), bytes.size() * 2 / 3, info, problem)) << ext;
+        EXPECT_NE(problem.find("cut short"), std::string::npos) << ext << ": " << problem;
+    }
+}
+
+TEST(ImageFile, ClaimedSizesAreCheckedBeforeDecoding) {
+    // A PFM header of 20 bytes that claims 65536 x 65536: refused from the header.
+    const std::string pfm = "Pf\n65536 65536\n-1.0\n";
+    ImageInfo info;
+    std::string problem;
+    EXPECT_FALSE(inspectImage(reinterpret_cast<const uint8_t *>(pfm.data()), pfm.size(), info, problem));
+    EXPECT_EQ(problem, "header claims 65536x65536 pixels; the limit is 32768 pixels a side");
+    const std::string small = "Pf\n2 2\n-1.0\n" + std::string(16, '\0');
+    EXPECT_TRUE(inspectImage(reinterpret_cast<const uint8_t *>(small.data()), small.size(), info, problem)) << problem;
+    EXPECT_EQ(info.dataOffset, small.size() - 16);
+    EXPECT_LT(info.scale, 0);
+    // A PNG whose IHDR claims 30000 x 30000.
+    cv::Mat m(4, 4, CV_8UC1, cv::Scalar(1));
+    auto png = encode(".png", m);
+    for (int k : {16, 20}) png[k] = 0, png[k + 1] = 0, png[k + 2] = 0x75, png[k + 3] = 0x30; // 30000
+    EXPECT_FALSE(inspectImage(png.data(), png.size(), info, problem));
+    EXPECT_EQ(problem, "header claims 30000x30000 pixels; the limit is 67108864 pixels in all");
+}
+
+TEST(ImageFile, ReadImageNamesTheFileAndTheReason) {
+    const std::string path = ::testing::TempDir() + "cut.png";
+    cv::Mat m(32, 32, CV_8UC1, cv::Scalar(9));
+    auto png = encode(".png", m);
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char *>(png.data()), static_cast<long>(png.size() - 12));
+    try {
+        readImage(path, cv::IMREAD_UNCHANGED, "left image");
+        FAIL() << "a PNG without IEND was decoded";
+    } catch (const ImageFileError &e) {
+        EXPECT_NE(std::string(e.what()).find("left image '" + path + "': PNG ends at byte"), std::string::npos) << e.what();
+        EXPECT_FALSE(e.notFound());
+    }
+    try {
+        readImage(path + ".missing", cv::IMREAD_UNCHANGED);
+        FAIL();
+    } catch (const ImageFileError &e) {
+        EXPECT_TRUE(e.notFound());
+    }
+}
+
+std::string yamlError(const std::string &text) {
+    try {
+        parseYaml(text, "x.yaml");
+    } catch (const YamlError &e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Yaml, DuplicateKeysBadUtf8AndSyntaxSayWhere) {
+    EXPECT_EQ(yamlError("a: 1\nb: 2\na: 3\n"), "x.yaml:3:1: key 'a' given twice in one map: first at 1:1, again at 3:1; remove one of them");
+    EXPECT_NE(yamlError("m:\n  - {x: 1, y: 2, x: 3}\n").find("x.yaml:2:18: key 'x' given twice"), std::string::npos);
+    EXPECT_EQ(yamlError("name: r\xffg\n"), "x.yaml:1:8: byte 0xFF is not valid UTF-8; expected a UTF-8 text (YAML files are UTF-8)");
+    EXPECT_NE(yamlError("a: [1, 2\n").find("x.yaml:"), std::string::npos);
+    EXPECT_EQ(yamlError("a: 1\nb: {c: 1, d: 2}\n"), "");
+    // An alias bomb: each level refers to the one before nine times; checked once each.
+    std::ostringstream bomb;
+    bomb << "l0: &l0 [a, b, c, d, e, f, g, h, i]\n";
+    for (int i = 1; i < 12; ++i) bomb << "l" << i << ": &l" << i << " [*l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << "]\n";
+    EXPECT_EQ(yamlError(bomb.str()), "");
+}
+
+} // namespace
