@@ -125,7 +125,7 @@ int calibrate(const Args &args) {
     StatedGeometry stated;
     if (!args.positional().empty()) {
         host.emplace();
-        host->scan();
+        // No scan: the rig opens only the plugins it names.
         rig = loadRigFromArgs(args, *host);
         stated = statedGeometry(rig->source);
     } else if (args.has("--set")) {

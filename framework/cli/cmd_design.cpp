@@ -123,7 +123,7 @@ int run(const Args &args) {
         // Measure η3D on the simulated rig for the best `--simulate-count` by figures.
         const size_t n = std::min(cands.size(), static_cast<size_t>(std::max<long long>(1, args.integer("--simulate-count", 12))));
         PluginHost host;
-        host.scan();
+        // No scan: the rig opens only the plugins it names.
         const std::string rig = args.get("--rig", dataFile("configs/rigs/sim-e1.yaml"));
         std::vector<TestGeometry> tests;
         std::vector<size_t> which;

@@ -32,7 +32,7 @@ std::string indentedList(const std::string &yaml) {
 
 int run(const Args &args) {
     PluginHost host;
-    host.scan();
+    host.scan(ScanMode::Isolated); // a source that crashes at load is refused, not fatal
     std::vector<const PluginRecord *> sources;
     if (args.has("--plugin")) {
         sources.push_back(&host.require(args.get("--plugin"), BINOCLE_KIND_STEREO_SOURCE));

@@ -13,7 +13,7 @@ namespace {
 int run(const Args &args) {
     if (args.positional().size() != 1) throw Error("expected one experiment file: binocle experiment FILE (see --help)");
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     // Everything is checked before the first test runs.
     Experiment e = loadExperiment(args.positional()[0], host);
     ExperimentOptions options;

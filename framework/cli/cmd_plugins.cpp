@@ -6,14 +6,31 @@
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace binocle::cli {
 namespace {
 
+// "int, odd, >= 1, <= 255", "enum: bm|sgbm", "required": what --verbose shows of a setting.
+std::string constraints(const binocle_param_desc &d) {
+    static const char *types[] = {"?", "bool", "int", "double", "string", "enum", "path", "yaml", "int list", "double list"};
+    std::ostringstream os;
+    os << types[(d.type >= 1 && d.type <= 9) ? d.type : 0];
+    if (d.type == BINOCLE_PARAM_ENUM && d.choices) os << " " << d.choices;
+    if (d.flags & BINOCLE_PARAM_FLAG_ODD) os << ", odd";
+    if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) os << ", >= " << d.min;
+    if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) os << ", <= " << d.max;
+    if (d.multiple_of > 0) os << ", multiple of " << d.multiple_of;
+    if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED) os << ", required";
+    return os.str();
+}
+
 int run(const Args &args) {
     PluginHost host;
     for (const auto &p : args.all("--load")) host.load(p);
-    host.scan();
+    // Each file is opened in a short-lived child first: one that crashes or hangs at load
+    // is listed as refused, and the listing goes on.
+    host.scan(ScanMode::Isolated, static_cast<int32_t>(args.integer("--timeout-ms", 2000)));
     const bool verbose = args.has("--verbose");
     std::cout << "search path:\n";
     for (const auto &d : host.searchPath()) std::cout << "  " << d << "\n";
@@ -28,7 +45,8 @@ int run(const Args &args) {
             std::cout << "      file: " << p.path << "\n";
             for (const auto &d : p.params())
                 std::cout << "      " << std::setw(24) << d.name << (d.default_value ? d.default_value : "(required)")
-                          << (d.unit && *d.unit ? std::string(" ") + d.unit : "") << "  " << (d.help ? d.help : "") << "\n";
+                          << (d.unit && *d.unit ? std::string(" ") + d.unit : "") << "  [" << constraints(d) << "]  "
+                          << (d.help ? d.help : "") << "\n";
         }
     }
     if (!host.refused().empty()) {
@@ -39,12 +57,16 @@ int run(const Args &args) {
 }
 
 Register reg({"plugins", "list the plugins found, with versions, and those refused and why",
-              "usage: binocle plugins [--verbose] [--load FILE]...\n\n"
+              "usage: binocle plugins [--verbose] [--load FILE]... [--timeout-ms N]\n\n"
               "Lists every plugin in the search path ($BINOCLE_PLUGIN_PATH, then the install\n"
-              "prefix, then the build tree) with its kind, version and ABI/API versions, and\n"
-              "every file that was refused with the reason.\n\n"
-              "  --verbose     also show each plugin's file and settings (YAML keys)\n"
-              "  --load FILE   load this plugin file as well (repeatable)\n",
+              "prefix) with its kind, version and ABI/API versions, and every file or folder\n"
+              "that was refused with the reason. Each file is first opened in a short-lived\n"
+              "child process: one that crashes or hangs while loading is refused with the\n"
+              "signal or the timeout.\n\n"
+              "  --verbose       also show each plugin's file and settings (YAML keys) with\n"
+              "                  type, choices, odd, min/max, multiple-of and required\n"
+              "  --load FILE     load this plugin file as well (repeatable)\n"
+              "  --timeout-ms N  how long a file may take to load (default 2000)\n",
               {"--verbose"},
               run});
 

@@ -28,7 +28,7 @@ int run(const Args &args) {
     if (args.positional().size() != 1) throw Error("expected one rig file: binocle record RIG.yaml --out DIR (see --help)");
     if (!args.has("--out") || args.get("--out").empty()) throw Error("missing --out DIR: the folder to record into");
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRigFromArgs(args, host);
     RecordOptions options;
     options.max_frames = args.integer("--frames", -1);

@@ -13,7 +13,7 @@ namespace {
 int run(const Args &args) {
     if (args.positional().size() != 1) throw Error("expected one rig file: binocle run RIG.yaml (see --help)");
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRigFromArgs(args, host);
     RunOptions options;
     options.max_frames = args.integer("--frames", -1);

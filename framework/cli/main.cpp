@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <spdlog/sinks/stderr_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 namespace binocle::cli {
 
@@ -110,6 +112,8 @@ void usage(std::ostream &os) {
 
 int main(int argc, char **argv) {
     using namespace binocle::cli;
+    // Diagnostics go to stderr: stdout carries results (a summary, a listing).
+    spdlog::set_default_logger(spdlog::stderr_color_mt("binocle"));
     std::vector<std::string> args(argv + 1, argv + argc);
     if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
         usage(args.empty() ? std::cerr : std::cout);
