@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
-#include <spdlog/sinks/stderr_color_sinks.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 namespace binocle::cli {

@@ -11,6 +11,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
+// This executable is not in bin/, where the helper would be found next to it.
+[[maybe_unused]] const int kHelper = ::setenv("BINOCLE_PLUGIN_HELPER", BINOCLE_PLUGIN_HELPER_PATH, 0);
+
 std::unique_ptr<Matcher> isolatedMatcher(const std::string &name, const std::string &yaml, IsolationOptions o = {}) {
     const PluginRecord &record = fixture(name, BINOCLE_KIND_MATCHER);
     ParamValues params = paramsFromYaml(record, yaml);

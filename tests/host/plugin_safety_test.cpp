@@ -57,12 +57,19 @@ TEST(PluginSafety, IsolatedScanRefusesCrashAndHangAtLoadAndGoesOn) {
 // The case: a folder holding an undefined symbol, a crash and a hang at load.
 TEST(PluginSafety, PluginsCommandListsTheThreeAsRefusedAndRunIgnoresThem) {
     const std::string path = std::string(BINOCLE_TEST_UNSAFE_PLUGIN_DIR) + ":" + BINOCLE_TEST_PLUGIN_DIR;
-    const auto t0 = std::chrono::steady_clock::now();
-    ProcessResult r = runBinocle({"plugins"}, path);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    auto timed = [](const std::string &p, ProcessResult &out) {
+        const auto t0 = std::chrono::steady_clock::now();
+        out = runBinocle({"plugins"}, p);
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    ProcessResult r;
+    // The hang costs its 2 s timeout, nothing more: compared with the same listing
+    // without the three files, in the same test (CI machines are shared and slow).
+    const double baseline = timed(BINOCLE_TEST_PLUGIN_DIR, r);
+    const double seconds = timed(path, r);
     ASSERT_TRUE(r.exited) << "killed by signal " << r.signal;
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_LT(seconds, 10.0);
+    EXPECT_LT(seconds - baseline, 8.0) << seconds << " s against " << baseline << " s without the three files";
     EXPECT_THAT(r.out, HasSubstr(unsafeFixture("undefined_symbol") + ": cannot be loaded: " + unsafeFixture("undefined_symbol") +
                                  ": undefined symbol: binocle_fixture_symbol_nobody_defines"));
     EXPECT_THAT(r.out, HasSubstr(unsafeFixture("crash_at_load") + ": crashed while loading (its code runs at load): killed by signal 11 (SIGSEGV)"));
