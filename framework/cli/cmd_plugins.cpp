@@ -30,7 +30,7 @@ int run(const Args &args) {
     for (const auto &p : args.all("--load")) host.load(p);
     // Each file is opened in a short-lived child first: one that crashes or hangs at load
     // is listed as refused, and the listing goes on.
-    host.scan(ScanMode::Isolated, static_cast<int32_t>(args.integer("--timeout-ms", 2000)));
+    host.scan(ScanMode::Isolated, static_cast<int32_t>(args.integer("--timeout-ms", 5000)));
     const bool verbose = args.has("--verbose");
     std::cout << "search path:\n";
     for (const auto &d : host.searchPath()) std::cout << "  " << d << "\n";
@@ -66,7 +66,7 @@ Register reg({"plugins", "list the plugins found, with versions, and those refus
               "  --verbose       also show each plugin's file and settings (YAML keys) with\n"
               "                  type, choices, odd, min/max, multiple-of and required\n"
               "  --load FILE     load this plugin file as well (repeatable)\n"
-              "  --timeout-ms N  how long a file may take to load (default 2000)\n",
+              "  --timeout-ms N  how long a file may take to load (default 5000)\n",
               {"--verbose"},
               run});
 

@@ -366,7 +366,11 @@ void MatcherHelper::start() {
     }
     socket_ = sv[0];
     sharedSent_ = false;
-    Reply r = call("create", Writer().put<uint32_t>(kCreate).data() + encodeParams(params_));
+    // create includes starting the helper (exec, dynamic loading): on a busy machine that
+    // alone can take seconds, so it gets at least kStartMs whatever call_timeout_ms says.
+    constexpr int32_t kStartMs = 15000;
+    Reply r = call("create", Writer().put<uint32_t>(kCreate).data() + encodeParams(params_), -1,
+                   options_.call_timeout_ms > 0 ? std::max(options_.call_timeout_ms, kStartMs) : 0);
     if (r.rc != BINOCLE_OK) throw PluginError(r.message, r.rc);
 }
 
@@ -390,7 +394,7 @@ void MatcherHelper::stopHelper() {
     }
 }
 
-MatcherHelper::Reply MatcherHelper::call(const std::string &what, const std::string &request, int fd) {
+MatcherHelper::Reply MatcherHelper::call(const std::string &what, const std::string &request, int fd, int32_t timeout_ms) {
     const std::string who = std::string(kindName(record_.kind)) + " plugin '" + record_.name + "' (" + record_.path + "): " + what;
     auto gone = [&](const std::string &how, int32_t code) -> HelperGone {
         ::close(socket_);
@@ -399,19 +403,20 @@ MatcherHelper::Reply MatcherHelper::call(const std::string &what, const std::str
         return HelperGone{who + " " + how, code};
     };
     if (socket_ < 0) throw HelperGone{who + ": its helper process is gone", BINOCLE_ERR_INTERNAL};
+    if (timeout_ms < 0) timeout_ms = options_.call_timeout_ms;
     const bool sent = sendMessage(socket_, request, fd);
-    const auto deadline = Clock::now() + std::chrono::milliseconds(options_.call_timeout_ms);
+    const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
     std::string msg;
     if (sent) {
         for (;;) {
             pollfd p{socket_, POLLIN, 0};
-            const int wait = options_.call_timeout_ms > 0 ? remainingMs(deadline) : -1;
+            const int wait = timeout_ms > 0 ? remainingMs(deadline) : -1;
             const int n = ::poll(&p, 1, wait);
             if (n < 0 && errno == EINTR) continue;
             if (n == 0) {
                 const int status = killAndReap(pid_);
                 (void)status;
-                throw gone("did not return within " + std::to_string(options_.call_timeout_ms) +
+                throw gone("did not return within " + std::to_string(timeout_ms) +
                                " ms (call_timeout_ms); its helper process was killed (" + describeSignal(SIGKILL) + ")",
                            BINOCLE_ERR_TIMEOUT);
             }

@@ -51,7 +51,8 @@ private:
     struct Reply;
     void start();
     void stopHelper();
-    Reply call(const std::string &what, const std::string &request, int fd = -1);
+    // timeout_ms < 0: call_timeout_ms.
+    Reply call(const std::string &what, const std::string &request, int fd = -1, int32_t timeout_ms = -1);
     void mapShared(size_t bytes);
 
     PluginRecord record_;

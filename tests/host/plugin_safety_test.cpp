@@ -40,13 +40,13 @@ TEST(PluginSafety, UndefinedSymbolIsARefusalNamingTheSymbol) {
 TEST(PluginSafety, IsolatedScanRefusesCrashAndHangAtLoadAndGoesOn) {
     PluginHost host(std::vector<std::string>{BINOCLE_TEST_UNSAFE_PLUGIN_DIR, BINOCLE_TEST_PLUGIN_DIR});
     const auto t0 = std::chrono::steady_clock::now();
-    host.scan(ScanMode::Isolated, 1000);
+    host.scan(ScanMode::Isolated, 3000);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    EXPECT_LT(seconds, 10.0);
+    EXPECT_LT(seconds, 20.0); // the 3 s of the hang, and a shared CI machine
     EXPECT_THAT(reasonFor(host, unsafeFixture("crash_at_load")),
                 HasSubstr("crashed while loading (its code runs at load): killed by signal 11 (SIGSEGV)"));
     EXPECT_THAT(reasonFor(host, unsafeFixture("hang_at_load")),
-                HasSubstr("still loading after 1000 ms (a library constructor hangs?); its examination was killed"));
+                HasSubstr("still loading after 3000 ms (a library constructor hangs?); its examination was killed"));
     EXPECT_THAT(reasonFor(host, unsafeFixture("undefined_symbol")),
                 HasSubstr("undefined symbol: binocle_fixture_symbol_nobody_defines"));
     // The listing went on: the fixtures of the next folder are all there.
@@ -63,17 +63,17 @@ TEST(PluginSafety, PluginsCommandListsTheThreeAsRefusedAndRunIgnoresThem) {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
     ProcessResult r;
-    // The hang costs its 2 s timeout, nothing more: compared with the same listing
+    // The hang costs its 5 s timeout, nothing more: compared with the same listing
     // without the three files, in the same test (CI machines are shared and slow).
     const double baseline = timed(BINOCLE_TEST_PLUGIN_DIR, r);
     const double seconds = timed(path, r);
     ASSERT_TRUE(r.exited) << "killed by signal " << r.signal;
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_LT(seconds - baseline, 8.0) << seconds << " s against " << baseline << " s without the three files";
+    EXPECT_LT(seconds - baseline, 10.0) << seconds << " s against " << baseline << " s without the three files";
     EXPECT_THAT(r.out, HasSubstr(unsafeFixture("undefined_symbol") + ": cannot be loaded: " + unsafeFixture("undefined_symbol") +
                                  ": undefined symbol: binocle_fixture_symbol_nobody_defines"));
     EXPECT_THAT(r.out, HasSubstr(unsafeFixture("crash_at_load") + ": crashed while loading (its code runs at load): killed by signal 11 (SIGSEGV)"));
-    EXPECT_THAT(r.out, HasSubstr(unsafeFixture("hang_at_load") + ": still loading after 2000 ms"));
+    EXPECT_THAT(r.out, HasSubstr(unsafeFixture("hang_at_load") + ": still loading after 5000 ms"));
     EXPECT_THAT(r.out, HasSubstr("mock_matcher")); // the listing went on
 
     TempDir dir;
