@@ -10,14 +10,15 @@
 namespace binocle::cli {
 namespace {
 
-int run(const Args &args) {
-    if (args.positional().size() != 1) throw Error("expected one plugin: binocle plugin-check FILE.so|NAME (see --help)");
+struct PluginCheckArgs {
     ConformanceOptions options;
-    options.plugin = args.positional()[0];
-    options.settings = args.all("--set");
-    options.case_timeout_ms = static_cast<int32_t>(args.integer("--timeout-ms", options.case_timeout_ms));
-    if (options.case_timeout_ms < 100) throw Error("option --timeout-ms = " + args.get("--timeout-ms") + ": expected at least 100");
-    const ConformanceReport report = checkPlugin(options);
+    long long timeout_ms = 20000;
+    std::string junit;
+};
+
+int checkPluginCommand(PluginCheckArgs &args) {
+    args.options.case_timeout_ms = static_cast<int32_t>(args.timeout_ms);
+    const ConformanceReport report = checkPlugin(args.options);
     static const char *words[] = {"PASS", "FAIL", "SKIP"};
     std::cout << "plugin-check " << report.path << (report.kind.empty() ? "" : " (" + report.kind + " '" + report.plugin + "')")
               << "\n";
@@ -26,12 +27,11 @@ int run(const Args &args) {
     using S = ConformanceCase::Status;
     std::cout << report.count(S::Passed) << " passed, " << report.count(S::Failed) << " failed, " << report.count(S::Skipped)
               << " skipped\n";
-    if (args.has("--junit")) writeFileAtomic(args.get("--junit"), junitXml(report));
-    return report.passed() ? 0 : 1;
+    if (!args.junit.empty()) writeFileAtomic(args.junit, junitXml(report));
+    return report.passed() ? kExitOk : kExitFailed;
 }
 
-Register reg({"plugin-check", "check a plugin against the ABI's rules (conformance kit), JUnit report",
-              "usage: binocle plugin-check FILE.so|NAME [--set KEY=VALUE]... [--junit FILE] [--timeout-ms N]\n\n"
+Register reg{{"plugin-check", "check a plugin against the ABI's rules (conformance kit), JUnit report",
               "Runs the conformance battery of the plugin's kind, each case in a child process\n"
               "(a crash or a hang is a failed case, with the signal or the timeout):\n"
               "  all kinds   load (in a child first; RTLD_NOW), table, settings, create/destroy\n"
@@ -44,12 +44,19 @@ Register reg({"plugin-check", "check a plugin against the ABI's rules (conforman
               "  transform   apply inside the host's arrays, empty cloud\n"
               "  evaluator   evaluate on read-only guarded inputs\n"
               "A source that needs a device it cannot find has its instance cases skipped,\n"
-              "saying why. Exit status 0 when no case failed.\n\n"
-              "  --set KEY=VALUE  a setting given to create (repeatable), e.g. --set window_px=7\n"
-              "  --junit FILE     write a JUnit XML report for CI\n"
-              "  --timeout-ms N   a case running longer fails (default 20000)\n",
-              {},
-              run});
+              "saying why. Exit status 0 when no case failed, 1 otherwise.",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<PluginCheckArgs>();
+                  app.add_option("plugin", args->options.plugin, "the plugin file (FILE.so) or name (binocle_NAME.so in the search path)")
+                      ->required()
+                      ->type_name("FILE.so|NAME");
+                  app.add_option("--set", args->options.settings, "a setting given to create (repeatable), e.g. --set window_px=7")
+                      ->type_name("KEY=VALUE")
+                      ->allow_extra_args(false);
+                  app.add_option("--junit", args->junit, "write a JUnit XML report for CI")->type_name("FILE");
+                  app.add_option("--timeout-ms", args->timeout_ms, "a case running longer fails (default 20000)")->check(atLeast(100));
+                  return [args] { return checkPluginCommand(*args); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

@@ -11,7 +11,13 @@
 namespace binocle::cli {
 namespace {
 
-// "int, odd, >= 1, <= 255", "enum: bm|sgbm", "required": what --verbose shows of a setting.
+struct PluginsArgs {
+    bool verbose = false;
+    std::vector<std::string> load;
+    long long timeout_ms = 5000;
+};
+
+// "int, odd, >= 1, <= 255", "enum bm|sgbm", "required": what --verbose shows of a setting.
 std::string constraints(const binocle_param_desc &d) {
     static const char *types[] = {"?", "bool", "int", "double", "string", "enum", "path", "yaml", "int list", "double list"};
     std::ostringstream os;
@@ -25,13 +31,12 @@ std::string constraints(const binocle_param_desc &d) {
     return os.str();
 }
 
-int run(const Args &args) {
+int listPlugins(const PluginsArgs &args) {
     PluginHost host;
-    for (const auto &p : args.all("--load")) host.load(p);
+    for (const auto &p : args.load) host.load(p);
     // Each file is opened in a short-lived child first: one that crashes or hangs at load
     // is listed as refused, and the listing goes on.
-    host.scan(ScanMode::Isolated, static_cast<int32_t>(args.integer("--timeout-ms", 5000)));
-    const bool verbose = args.has("--verbose");
+    host.scan(ScanMode::Isolated, static_cast<int32_t>(args.timeout_ms));
     std::cout << "search path:\n";
     for (const auto &d : host.searchPath()) std::cout << "  " << d << "\n";
     std::cout << "\nplugins (host ABI " << BINOCLE_ABI_VERSION << ", API " << BINOCLE_API_VERSION << "):\n";
@@ -41,7 +46,7 @@ int run(const Args &args) {
     for (const auto &p : host.plugins()) {
         std::cout << "  " << std::left << std::setw(static_cast<int>(nameWidth)) << p.name << std::setw(10) << kindName(p.kind) << std::setw(9)
                   << p.version << "ABI " << p.abi_version << " API " << p.api_version << "  " << p.description << "\n";
-        if (verbose) {
+        if (args.verbose) {
             std::cout << "      file: " << p.path << "\n";
             for (const auto &d : p.params())
                 std::cout << "      " << std::setw(24) << d.name << (d.default_value ? d.default_value : "(required)")
@@ -56,19 +61,24 @@ int run(const Args &args) {
     return 0;
 }
 
-Register reg({"plugins", "list the plugins found, with versions, and those refused and why",
-              "usage: binocle plugins [--verbose] [--load FILE]... [--timeout-ms N]\n\n"
+Register reg{{"plugins", "list the plugins found, with versions, and those refused and why",
               "Lists every plugin in the search path ($BINOCLE_PLUGIN_PATH, then the install\n"
-              "prefix) with its kind, version and ABI/API versions, and every file or folder\n"
-              "that was refused with the reason. Each file is first opened in a short-lived\n"
-              "child process: one that crashes or hangs while loading is refused with the\n"
-              "signal or the timeout.\n\n"
-              "  --verbose       also show each plugin's file and settings (YAML keys) with\n"
-              "                  type, choices, odd, min/max, multiple-of and required\n"
-              "  --load FILE     load this plugin file as well (repeatable)\n"
-              "  --timeout-ms N  how long a file may take to load (default 5000)\n",
-              {"--verbose"},
-              run});
+              "prefix next to this executable) with its kind, version and ABI/API versions, and\n"
+              "every file or folder that was refused with the reason. Each file is first opened\n"
+              "in a short-lived child process: one that crashes or hangs while loading is\n"
+              "refused with the signal or the timeout.",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<PluginsArgs>();
+                  app.add_flag("--verbose", args->verbose,
+                               "also show each plugin's file and settings (YAML keys) with type, choices, odd, "
+                               "min/max, multiple-of and required");
+                  app.add_option("--load", args->load, "load this plugin file as well (repeatable)")
+                      ->type_name("FILE")
+                      ->allow_extra_args(false);
+                  app.add_option("--timeout-ms", args->timeout_ms, "how long a file may take to load (default 5000)")
+                      ->check(atLeast(100));
+                  return [args] { return listPlugins(*args); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

@@ -2,6 +2,7 @@
 // The plugin host: search path, loading with Boost.DLL, ABI checks, instance wrappers.
 #include "host/plugin_host.hpp"
 
+#include "core/log.hpp"
 #include "host/isolation.hpp"
 
 #include <algorithm>
@@ -586,9 +587,7 @@ void hostLog(void *ctx, int32_t level, const char *message) {
         auto *c = static_cast<SinkContext *>(ctx);
         std::string msg = message ? message : "";
         if (c->sink.log) return c->sink.log(level, msg);
-        static const spdlog::level::level_enum levels[] = {spdlog::level::debug, spdlog::level::info, spdlog::level::warn,
-                                                           spdlog::level::err};
-        spdlog::log(levels[std::clamp(level, 0, 3)], "[{}] {}", c->plugin, msg);
+        logFromPlugin(c->plugin, level, msg);
     } catch (...) {
     }
 }
