@@ -1,11 +1,27 @@
 # SPDX-License-Identifier: MIT
-# binocle_add_plugin(<name> SOURCES <files...> [LIBRARIES <targets...>] [NO_INSTALL])
+# binocle_add_plugin(<name> SOURCES <files...> [LIBRARIES <targets...>]
+#                    [OUTPUT_DIRECTORY <dir>] [NO_INSTALL])
 #
 # Builds a Binocle plugin: a MODULE library with hidden visibility that exports only
-# its init symbol, named binocle_<name>.so. Installed with the SDK, so that a plugin
-# built outside this tree uses the very same function.
+# its init symbol (binocle_plugin_init, enforced by a linker version script), named
+# binocle_<name>.so. <name> must be the name the plugin declares in its table
+# ([a-z0-9_]+): the host finds a rig's plugin by that file name alone, and refuses a
+# file whose name differs. Installed with the SDK, so that a plugin built outside this
+# tree uses the very same function.
+#   SOURCES           the plugin's source files
+#   LIBRARIES         libraries to link, privately (OpenCV, your own code ...)
+#   OUTPUT_DIRECTORY  where the built .so goes (default: the build's plugin folder when
+#                     there is one, else CMake's default)
+#   NO_INSTALL        do not install it (test fixtures); otherwise it installs into
+#                     BINOCLE_PLUGIN_INSTALL_DIR (the SDK's BINOCLE_PLUGIN_DIR unless the
+#                     project set its own), where the installed `binocle` finds it
+# Plugins that install are listed in the global property BINOCLE_PLUGINS (plugin-check
+# runs against each in CI).
 function(binocle_add_plugin name)
   cmake_parse_arguments(ARG "NO_INSTALL" "OUTPUT_DIRECTORY" "SOURCES;LIBRARIES" ${ARGN})
+  if(NOT name MATCHES "^[a-z0-9_]+$")
+    message(FATAL_ERROR "binocle_add_plugin(${name}): a plugin name is [a-z0-9_]+ (it is a YAML value and a file name)")
+  endif()
   set(target binocle_plugin_${name})
   add_library(${target} MODULE ${ARG_SOURCES})
   if(TARGET Binocle::sdk)
@@ -41,5 +57,8 @@ function(binocle_add_plugin name)
     else()
       install(TARGETS ${target} LIBRARY DESTINATION "${BINOCLE_PLUGIN_INSTALL_DIR}")
     endif()
+  endif()
+  if(NOT ARG_NO_INSTALL)
+    set_property(GLOBAL APPEND PROPERTY BINOCLE_PLUGINS ${name})
   endif()
 endfunction()

@@ -141,7 +141,7 @@ int calibrate(const CalibrateArgs &args, const CLI::App &app) {
     StatedGeometry stated;
     if (!args.rig.file.empty()) {
         host.emplace();
-        host->scan();
+        // No scan: the rig opens only the plugins it names.
         rig = loadRig(args.rig, *host);
         stated = statedGeometry(rig->source);
     } else if (!args.rig.overrides.empty()) {

@@ -145,7 +145,7 @@ int design(const DesignArgs &args) {
         // Measure η3D on the simulated rig for the best `--simulate-count` by figures.
         const size_t n = std::min(cands.size(), static_cast<size_t>(args.simulate_count));
         PluginHost host;
-        host.scan();
+        // No scan: the rig opens only the plugins it names.
         const std::string rig = args.rig.empty() ? dataFile("configs/rigs/sim-e1.yaml") : args.rig;
         std::vector<TestGeometry> tests;
         std::vector<size_t> which;

@@ -33,7 +33,7 @@ std::string indentedList(const std::string &yaml) {
 
 int listDevices(const std::string &plugin) {
     PluginHost host;
-    host.scan();
+    host.scan(ScanMode::Isolated); // a source that crashes at load is refused, not fatal
     std::vector<const PluginRecord *> sources;
     if (!plugin.empty()) {
         sources.push_back(&host.require(plugin, BINOCLE_KIND_STEREO_SOURCE));

@@ -33,7 +33,7 @@ int experiment(const ExperimentArgs &args) {
     if (!args.merge.empty()) return merge(args.merge);
     if (args.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     // Everything is checked before the first test runs.
     Experiment e = loadExperiment(args.file, host, args.set);
     if (args.check) {

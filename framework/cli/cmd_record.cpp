@@ -36,7 +36,7 @@ struct RecordArgs {
 int record(const RecordArgs &args) {
     if (args.out.empty()) throw UsageError("--out: expected the folder to record into");
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRig(args.rig, host);
     RecordOptions options;
     options.max_frames = args.frames;

@@ -22,7 +22,7 @@ struct RunArgs {
 
 int runRig(const RunArgs &args) {
     PluginHost host;
-    host.scan();
+    // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRig(args.rig, host);
     RunOptions options;
     options.max_frames = args.frames;

@@ -88,10 +88,12 @@ struct Context {
     Location at(const YAML::Node &node, const std::string &path) const {
         Location loc;
         loc.file = file;
-        for (const auto &o : overrides) {
-            auto a = splitPath(o.path), b = splitPath(path);
-            if (a == b) {
-                loc.override = o.text;
+        // The last --set that wrote this value or a block around it (`matcher={...}`
+        // replaces the whole block: its keys come from the command line, not the file).
+        for (auto o = overrides.rbegin(); o != overrides.rend(); ++o) {
+            auto a = splitPath(o->path), b = splitPath(path);
+            if (a.size() <= b.size() && std::equal(a.begin(), a.end(), b.begin())) {
+                loc.override = o->text;
                 return loc;
             }
         }
@@ -231,6 +233,40 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
     }
 }
 
+// Keys of every plugin block besides the plugin's own settings.
+const std::vector<std::string> kBlockKeys = {"plugin", "isolation", "call_timeout_ms", "restart", "max_restarts"};
+
+// `isolation: process|none`, `call_timeout_ms`, `restart`, `max_restarts` of a block.
+IsolationOptions isolationOf(const YAML::Node &node, const std::string &where, int32_t kind, const Context &ctx) {
+    IsolationOptions o;
+    if (YAML::Node n = node["isolation"]) {
+        if (!n.IsScalar() || (n.Scalar() != "process" && n.Scalar() != "none"))
+            ctx.fail(n, where + ".isolation", "value '" + scalarText(n) + "' is not valid: expected process or none");
+        o.process = n.Scalar() == "process";
+        if (o.process && kind != BINOCLE_KIND_MATCHER)
+            ctx.fail(n, where + ".isolation", std::string("isolation: process is supported for matchers only, not for a ") +
+                                                 kindName(kind) + " (yet)");
+    }
+    auto integer = [&](const char *key, int32_t &v, int32_t least) {
+        YAML::Node n = node[key];
+        if (!n) return;
+        long long x = 0;
+        if (!n.IsScalar() || !YAML::convert<long long>::decode(n, x) || x < least || x > 3600000)
+            ctx.fail(n, where + "." + key, "value '" + scalarText(n) + "' is not valid: expected an integer >= " +
+                                               std::to_string(least));
+        v = static_cast<int32_t>(x);
+    };
+    integer("call_timeout_ms", o.call_timeout_ms, 0);
+    integer("max_restarts", o.max_restarts, 0);
+    if (YAML::Node n = node["restart"]) {
+        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, o.restart))
+            ctx.fail(n, where + ".restart", "value '" + scalarText(n) + "' is not valid: expected true or false");
+    }
+    if (!o.process && (node["call_timeout_ms"] || node["restart"] || node["max_restarts"]))
+        ctx.fail(node, where, "call_timeout_ms, restart and max_restarts need isolation: process");
+    return o;
+}
+
 ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, const std::string &where, const Context &ctx) {
     const auto descs = record.params();
     std::vector<std::string> names;
@@ -240,7 +276,7 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
     if (block.IsMap()) {
         for (const auto &kv : block) {
             const std::string key = keyText(kv.first);
-            if (key == "plugin") continue;
+            if (std::find(kBlockKeys.begin(), kBlockKeys.end(), key) != kBlockKeys.end()) continue;
             if (std::find(names.begin(), names.end(), key) != names.end()) continue;
             std::string hint = nearest(key, names);
             std::string all;
@@ -349,8 +385,11 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
     b.where = where;
     b.plugin = p.Scalar();
     b.location = ctx.at(node, where);
-    b.record = host.find(b.plugin, kind);
+    // Opens binocle_<name>.so only; the whole search path is examined (in children) only
+    // to say what else there is.
+    b.record = host.lookup(b.plugin, kind);
     if (!b.record) {
+        host.scan(ScanMode::Isolated);
         std::vector<std::string> names;
         for (const auto &r : host.plugins())
             if (r.kind == kind) names.push_back(r.name);
@@ -364,6 +403,7 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
                                            " (available: " + (all.empty() ? "none" : all) + ")" + refused);
     }
     b.params = resolveWith(*b.record, node, where, ctx);
+    b.params.setIsolation(isolationOf(node, where, kind, ctx));
     return b;
 }
 

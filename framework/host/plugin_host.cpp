@@ -3,14 +3,19 @@
 #include "host/plugin_host.hpp"
 
 #include "core/log.hpp"
+#include "host/isolation.hpp"
 
 #include <algorithm>
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <sstream>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
 
 namespace fs = std::filesystem;
 
@@ -44,10 +49,29 @@ const char *resultName(int32_t code) {
 
 // ---- Records ------------------------------------------------------------------------
 
+// End of a table entry: offsetof + sizeof. An entry's offset never changes once an API
+// version has shipped (tables only grow at their end), so these values are frozen.
+#define BINOCLE_END_OF(type, member) (offsetof(type, member) + sizeof(static_cast<type *>(nullptr)->member))
+
 namespace {
 
-// Size of each kind's table in ABI 1, API 1: the least a plugin may declare.
-size_t minimumTableSize(int32_t kind) {
+struct TableVersion {
+    int32_t kind;
+    uint32_t api_version;
+    size_t least;    // end of the last entry of that API version
+    const char *last; // name of that entry, for messages
+};
+
+// One row per kind and API version. API 2 adds rows; it never edits these.
+const TableVersion kTableVersions[] = {
+    {BINOCLE_KIND_STEREO_SOURCE, 1, BINOCLE_END_OF(binocle_source_api, enumerate_devices), "enumerate_devices"},
+    {BINOCLE_KIND_MATCHER, 1, BINOCLE_END_OF(binocle_matcher_api, disparity_range), "disparity_range"},
+    {BINOCLE_KIND_CLOUD_TRANSFORM, 1, BINOCLE_END_OF(binocle_cloud_transform_api, apply), "apply"},
+    {BINOCLE_KIND_EVALUATOR, 1, BINOCLE_END_OF(binocle_evaluator_api, finish), "finish"},
+};
+
+// Size of the kind's table as this host knows it (its own API version).
+size_t hostTableSize(int32_t kind) {
     switch (kind) {
     case BINOCLE_KIND_STEREO_SOURCE: return sizeof(binocle_source_api);
     case BINOCLE_KIND_MATCHER: return sizeof(binocle_matcher_api);
@@ -56,6 +80,25 @@ size_t minimumTableSize(int32_t kind) {
     default: return 0;
     }
 }
+
+// Big enough for any kind's table: the host's normalised copy lives in one of these.
+union AnyTable {
+    binocle_plugin_header header;
+    binocle_source_api source;
+    binocle_matcher_api matcher;
+    binocle_cloud_transform_api transform;
+    binocle_evaluator_api evaluator;
+};
+
+} // namespace
+
+size_t leastTableSize(int32_t kind, uint32_t api_version) {
+    for (const auto &v : kTableVersions)
+        if (v.kind == kind && v.api_version == api_version) return v.least;
+    return 0;
+}
+
+namespace {
 
 struct ParamTable {
     const binocle_param_desc *params;
@@ -144,6 +187,83 @@ std::string join(const std::vector<std::string> &v, const char *sep = ", ") {
 
 } // namespace
 
+// ---- Settings tables --------------------------------------------------------------------
+
+namespace {
+
+std::string formatNumber(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
+
+// Why `text` is not a valid value of setting `d`, or "" when it is. The same rules as the
+// rig validation (config/), applied to the plugin's own default.
+std::string defaultProblem(const binocle_param_desc &d, const std::string &text) {
+    auto range = [&](double v) -> std::string {
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) return "is below its min " + formatNumber(d.min);
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) return "is above its max " + formatNumber(d.max);
+        return "";
+    };
+    switch (d.type) {
+    case BINOCLE_PARAM_BOOL: {
+        static const char *words[] = {"true", "false", "True", "False", "TRUE", "FALSE", "yes", "no", "on", "off"};
+        for (const char *w : words)
+            if (text == w) return "";
+        return "is not a boolean (true or false)";
+    }
+    case BINOCLE_PARAM_INT: {
+        char *end = nullptr;
+        errno = 0;
+        const long long v = std::strtoll(text.c_str(), &end, 0);
+        if (text.empty() || errno || *end) return "is not an integer";
+        if (std::string r = range(static_cast<double>(v)); !r.empty()) return r;
+        if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) return "is not odd";
+        if (d.multiple_of > 0 && v % d.multiple_of != 0) return "is not a multiple of " + std::to_string(d.multiple_of);
+        return "";
+    }
+    case BINOCLE_PARAM_DOUBLE: {
+        char *end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end) return "is not a number";
+        if (!std::isfinite(v)) return "is not finite";
+        return range(v);
+    }
+    case BINOCLE_PARAM_ENUM: {
+        std::stringstream ss(d.choices ? d.choices : "");
+        for (std::string c; std::getline(ss, c, '|');)
+            if (c == text) return "";
+        return std::string("is not one of its choices '") + (d.choices ? d.choices : "") + "'";
+    }
+    default: return ""; // strings, paths, YAML and lists: any text
+    }
+}
+
+} // namespace
+
+std::string settingsTableProblem(const binocle_param_desc *params, int32_t count) {
+    if (count < 0 || count > 1000 || (count > 0 && !params))
+        return "a garbage settings table (count " + std::to_string(count) + ")";
+    std::map<std::string, int32_t> seen;
+    for (int32_t i = 0; i < count; ++i) {
+        const auto &d = params[i];
+        const std::string at = "setting #" + std::to_string(i) + " '" + (d.name ? d.name : "(null)") + "'";
+        if (!validName(d.name)) return at + ": invalid name (expected [a-z0-9_]+, e.g. window_px)";
+        if (d.type < BINOCLE_PARAM_BOOL || d.type > BINOCLE_PARAM_DOUBLE_LIST)
+            return at + ": unknown type " + std::to_string(d.type) + " (expected a BINOCLE_PARAM_* value)";
+        if (auto [it, fresh] = seen.emplace(d.name, i); !fresh)
+            return at + ": the name is declared twice (also setting #" + std::to_string(it->second) + ")";
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && d.min > d.max)
+            return at + ": min " + formatNumber(d.min) + " is above max " + formatNumber(d.max);
+        if (d.type == BINOCLE_PARAM_ENUM && (!d.choices || !*d.choices)) return at + ": an enum without choices";
+        if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED) continue;
+        if (!d.default_value) return at + ": no default, and not flagged BINOCLE_PARAM_FLAG_REQUIRED";
+        if (std::string why = defaultProblem(d, d.default_value); !why.empty())
+            return at + ": default '" + d.default_value + "' " + why;
+    }
+    return "";
+}
+
 std::vector<binocle_param_desc> PluginRecord::params() const {
     ParamTable t = paramTable(table);
     if (!t.params || t.count <= 0) return {};
@@ -151,6 +271,32 @@ std::vector<binocle_param_desc> PluginRecord::params() const {
 }
 
 // ---- Search and load ---------------------------------------------------------------------
+
+namespace {
+
+constexpr const char *kPrefix = "binocle_";
+
+bool isPluginFileName(const std::string &name) {
+    return name.size() > 11 && name.rfind(kPrefix, 0) == 0 && name.compare(name.size() - 3, 3, ".so") == 0;
+}
+
+// Why loading code from `path` is unsafe, or "": anyone but the owner (and root) could
+// have put code there. Relative entries would depend on the working directory.
+std::string unsafeReason(const std::string &path, bool folder) {
+    if (fs::path(path).is_relative())
+        return "relative search path entry (it would resolve against the working directory); use an absolute path";
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return "";
+    if (st.st_mode & (S_IWGRP | S_IWOTH)) {
+        std::ostringstream os;
+        os << (folder ? "folder" : "file") << " is writable by others than its owner and root (mode " << std::oct
+           << (st.st_mode & 07777) << "); run chmod go-w on it";
+        return os.str();
+    }
+    return "";
+}
+
+} // namespace
 
 std::vector<std::string> PluginHost::defaultSearchPath() {
     std::vector<std::string> path;
@@ -161,13 +307,13 @@ std::vector<std::string> PluginHost::defaultSearchPath() {
             if (!dir.empty()) path.push_back(dir);
     }
     try {
+        // The build tree mirrors the install layout (bin/, lib/binocle/plugins/), so this
+        // one entry serves both; nothing about the build tree is compiled in.
         fs::path exe = boost::dll::program_location().string();
-        path.push_back((exe.parent_path().parent_path() / BINOCLE_PLUGIN_INSTALL_DIR).string());
+        path.push_back((exe.parent_path().parent_path() / BINOCLE_PLUGIN_INSTALL_DIR).lexically_normal().string());
     } catch (...) {
         // No program location (unusual); the other entries still apply.
     }
-    path.emplace_back(BINOCLE_BUILD_PLUGIN_DIR);
-    // The build tree mirrors the install layout: drop a folder named twice.
     std::vector<std::string> unique;
     for (const auto &d : path) {
         std::error_code ec;
@@ -181,27 +327,54 @@ std::vector<std::string> PluginHost::defaultSearchPath() {
 PluginHost::PluginHost(std::vector<std::string> searchPath) : searchPath_(std::move(searchPath)) {}
 PluginHost::~PluginHost() = default;
 
-void PluginHost::scan() {
+bool PluginHost::known(const std::string &canonical) const {
+    return std::any_of(plugins_.begin(), plugins_.end(), [&](const PluginRecord &r) { return r.path == canonical; }) ||
+           std::any_of(refused_.begin(), refused_.end(), [&](const Refusal &r) { return r.path == canonical; });
+}
+
+std::vector<std::string> PluginHost::safeFolders() const {
+    std::vector<std::string> out;
     for (const auto &dir : searchPath_) {
         std::error_code ec;
-        if (!fs::is_directory(dir, ec)) continue;
+        if (std::string why = unsafeReason(dir, true); !why.empty()) {
+            if (!known(dir)) refused_.push_back({dir, why});
+            continue;
+        }
+        if (fs::is_directory(dir, ec)) out.push_back(dir);
+    }
+    return out;
+}
+
+void PluginHost::scan(ScanMode mode, int32_t child_timeout_ms) const {
+    std::vector<std::string> todo;
+    std::vector<std::string> fileNames; // first folder wins for a file name
+    for (const auto &dir : safeFolders()) {
+        std::error_code ec;
         std::vector<fs::path> files;
         for (const auto &entry : fs::directory_iterator(dir, ec)) {
             const auto name = entry.path().filename().string();
-            if (entry.is_regular_file(ec) && name.rfind("binocle_", 0) == 0 && entry.path().extension() == ".so")
-                files.push_back(entry.path());
+            if (entry.is_regular_file(ec) && isPluginFileName(name)) files.push_back(entry.path());
         }
         std::sort(files.begin(), files.end());
         for (const auto &f : files) {
             const std::string canonical = fs::weakly_canonical(f, ec).string();
-            bool seen = std::any_of(plugins_.begin(), plugins_.end(), [&](const PluginRecord &r) { return r.path == canonical; }) ||
-                        std::any_of(refused_.begin(), refused_.end(), [&](const Refusal &r) { return r.path == canonical; });
-            if (seen) continue;
-            try {
-                inspect(canonical);
-            } catch (const Error &e) {
-                refused_.push_back({canonical, e.what()});
-            }
+            const std::string name = f.filename().string();
+            if (known(canonical) || std::find(fileNames.begin(), fileNames.end(), name) != fileNames.end()) continue;
+            fileNames.push_back(name);
+            todo.push_back(canonical);
+        }
+    }
+    std::map<std::string, std::string> childRefusals;
+    if (mode == ScanMode::Isolated) childRefusals = examineInChildren(todo, child_timeout_ms);
+    for (const auto &path : todo) {
+        if (auto it = childRefusals.find(path); it != childRefusals.end()) {
+            refused_.push_back({path, it->second});
+            continue;
+        }
+        try {
+            inspect(path);
+        } catch (const Error &e) {
+            refused_.push_back({path, e.what()});
         }
     }
 }
@@ -218,12 +391,47 @@ const PluginRecord &PluginHost::load(const std::string &path) {
     }
 }
 
-const PluginRecord &PluginHost::inspect(const std::string &path) {
+std::string PluginHost::locate(const std::string &name) const {
+    if (!validName(name.c_str())) return "";
+    for (const auto &dir : safeFolders()) {
+        std::error_code ec;
+        const fs::path file = fs::path(dir) / (kPrefix + name + ".so");
+        if (fs::exists(file, ec)) return fs::weakly_canonical(file, ec).string();
+    }
+    return "";
+}
+
+const PluginRecord *PluginHost::lookup(const std::string &name, int32_t kind) const {
+    if (const PluginRecord *r = find(name)) return kind == 0 || r->kind == kind ? r : nullptr;
+    const std::string path = locate(name);
+    if (path.empty()) return nullptr;
+    if (known(path)) return find(name, kind);
+    try {
+        const PluginRecord &r = inspect(path);
+        return kind == 0 || r.kind == kind ? &r : nullptr;
+    } catch (const Error &e) {
+        refused_.push_back({path, e.what()});
+        return nullptr;
+    }
+}
+
+const PluginRecord &PluginHost::inspect(const std::string &path) const {
+    if (std::string why = unsafeReason(path, false); !why.empty()) throw Error(why);
     auto lib = std::make_shared<boost::dll::shared_library>();
     try {
-        lib->load(path, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+        // RTLD_NOW: a missing symbol is a refusal here, naming it, not a crash at the
+        // first call. The library's constructors run now, before any check.
+        lib->load(path, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
     } catch (const std::exception &e) {
-        throw Error(std::string("cannot be loaded: ") + e.what());
+        // Boost wraps dlerror's text ("... (dlerror system message: <why>): <errno text>");
+        // the dynamic loader's own words name the file and the missing symbol.
+        std::string why = e.what();
+        const std::string marker = "dlerror system message: ";
+        if (auto at = why.find(marker); at != std::string::npos) {
+            why = why.substr(at + marker.size());
+            if (auto end = why.rfind("): "); end != std::string::npos) why = why.substr(0, end);
+        }
+        throw Error("cannot be loaded: " + why);
     }
     if (!lib->has(BINOCLE_PLUGIN_INIT_SYMBOL))
         throw Error(std::string("no init symbol '") + BINOCLE_PLUGIN_INIT_SYMBOL +
@@ -245,23 +453,36 @@ const PluginRecord &PluginHost::inspect(const std::string &path) {
     if (h->struct_size < sizeof(binocle_plugin_header))
         throw Error("table size " + std::to_string(h->struct_size) + " is smaller than the plugin header (" +
                     std::to_string(sizeof(binocle_plugin_header)) + " bytes)");
-    const size_t minSize = minimumTableSize(h->kind);
-    if (minSize == 0) throw Error("unknown plugin kind " + std::to_string(h->kind));
-    if (h->struct_size < minSize)
+    const size_t hostSize = hostTableSize(h->kind);
+    if (hostSize == 0) throw Error("unknown plugin kind " + std::to_string(h->kind));
+    if (h->api_version == 0) throw Error("API version 0 (the first API version is 1)");
+    // Least size: API 1's for any plugin; the declared version's when the host knows it.
+    size_t least = leastTableSize(h->kind, 1);
+    uint32_t leastApi = 1;
+    for (uint32_t v = 2; v <= std::min<uint32_t>(h->api_version, BINOCLE_API_VERSION); ++v)
+        if (size_t s = leastTableSize(h->kind, v)) least = s, leastApi = v;
+    if (h->struct_size < least)
         throw Error("table size " + std::to_string(h->struct_size) + " is smaller than the " + kindName(h->kind) +
-                    " table of ABI " + std::to_string(BINOCLE_ABI_VERSION) + " (" + std::to_string(minSize) + " bytes)");
+                    " table of ABI " + std::to_string(BINOCLE_ABI_VERSION) + " API " + std::to_string(leastApi) + " (" +
+                    std::to_string(least) + " bytes)");
     if (!validName(h->name))
         throw Error(std::string("invalid plugin name '") + (h->name ? h->name : "(null)") + "' (expected [a-z0-9_]+)");
-    auto missing = missingEntries(h);
+    const std::string fileName = fs::path(path).filename().string();
+    if (fileName != kPrefix + std::string(h->name) + ".so")
+        throw Error(std::string("declares the name '") + h->name + "' but its file is " + fileName + " (the file of plugin <name> must be binocle_<name>.so)");
+
+    // The host's copy: entries past struct_size read as absent (NULL), and entries a
+    // newer plugin appended past the host's own table are not read.
+    auto storage = std::make_shared<AnyTable>();
+    std::memset(static_cast<void *>(storage.get()), 0, sizeof(AnyTable));
+    std::memcpy(static_cast<void *>(storage.get()), h, std::min<size_t>(h->struct_size, hostSize));
+    const binocle_plugin_header *copy = &storage->header;
+
+    auto missing = missingEntries(copy);
     if (!missing.empty()) throw Error(std::string("plugin '") + h->name + "' leaves mandatory entries NULL: " + join(missing));
-    ParamTable pt = paramTable(h);
-    if (pt.count < 0 || pt.count > 1000 || (pt.count > 0 && !pt.params))
-        throw Error(std::string("plugin '") + h->name + "' declares a garbage settings table (count " + std::to_string(pt.count) + ")");
-    for (int32_t i = 0; i < pt.count; ++i) {
-        const auto &d = pt.params[i];
-        if (!validName(d.name) || d.type < BINOCLE_PARAM_BOOL || d.type > BINOCLE_PARAM_DOUBLE_LIST)
-            throw Error(std::string("plugin '") + h->name + "' declares an invalid setting #" + std::to_string(i));
-    }
+    ParamTable pt = paramTable(copy);
+    if (std::string why = settingsTableProblem(pt.params, pt.count); !why.empty())
+        throw Error(std::string("plugin '") + h->name + "' declares " + why);
     if (const PluginRecord *other = find(h->name))
         throw Error(std::string("plugin name '") + h->name + "' is already provided by " + other->path);
 
@@ -273,7 +494,8 @@ const PluginRecord &PluginHost::inspect(const std::string &path) {
     r.kind = h->kind;
     r.abi_version = h->abi_version;
     r.api_version = h->api_version;
-    r.table = h;
+    r.table = copy;
+    r.tableStorage = storage;
     r.library = lib;
     plugins_.push_back(std::move(r));
     return plugins_.back();
@@ -286,7 +508,7 @@ const PluginRecord *PluginHost::find(const std::string &name, int32_t kind) cons
 }
 
 const PluginRecord &PluginHost::require(const std::string &name, int32_t kind) const {
-    if (const PluginRecord *r = find(name, kind)) return *r;
+    if (const PluginRecord *r = lookup(name, kind)) return *r;
     std::vector<std::string> names;
     for (const auto &r : plugins_)
         if (kind == 0 || r.kind == kind) names.push_back(r.name);
@@ -487,7 +709,13 @@ LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_source_api *api, 
 
 LentFrame::~LentFrame() {
     try {
-        api_->release_frame(src_, frame_.frame_id);
+        const int32_t rc = api_->release_frame(src_, frame_.frame_id);
+        if (rc != BINOCLE_OK) {
+            const char *why = api_->last_error(src_);
+            spdlog::error("source plugin '{}': release_frame of frame {} (sequence {}) failed ({}){}{}",
+                          api_->header.name ? api_->header.name : "?", frame_.frame_id,
+                          frame_.sequence, resultName(rc), why && *why ? ": " : "", why ? why : "");
+        }
     } catch (...) {
     }
 }
@@ -609,6 +837,11 @@ std::string Source::enumerateDevices(const PluginRecord &record) {
 
 Matcher::Matcher(const PluginRecord &record, const ParamValues &params)
     : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_matcher_api *>(record.table)) {
+    if (params.isolation().process) {
+        // The plugin's create and every later call run in the helper process only.
+        helper_ = std::make_unique<MatcherHelper>(record, params);
+        return;
+    }
     int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
     if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
 }
@@ -628,6 +861,32 @@ void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispar
         throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
     disparity.create(left.size(), CV_32F);
     disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
+    if (helper_) helper_->compute(left, right, disparity);
+    else computeInto(left, right, disparity);
+    // A disparity is at most the image width; inf, NaN or 1e30 would become cloud points.
+    const float limit = static_cast<float>(disparity.cols);
+    uint64_t bad = 0;
+    for (int y = 0; y < disparity.rows; ++y) {
+        float *row = disparity.ptr<float>(y);
+        for (int x = 0; x < disparity.cols; ++x)
+            if (!std::isfinite(row[x]) || row[x] > limit) {
+                row[x] = BINOCLE_INVALID_DISPARITY;
+                ++bad;
+            }
+    }
+    if (bad) {
+        invalidated_ += bad;
+        if (!warnedInvalid_)
+            spdlog::warn("matcher plugin '{}': {} disparities not finite or beyond the image width ({} px) made invalid "
+                         "(counted; further frames at debug level)", record_.name, bad, disparity.cols);
+        else
+            spdlog::debug("matcher plugin '{}': {} disparities not finite or absurd made invalid ({} so far)", record_.name,
+                          bad, invalidated_);
+        warnedInvalid_ = true;
+    }
+}
+
+void Matcher::computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) {
     binocle_image l = wrap(left, formatOf(left)), r = wrap(right, formatOf(right));
     binocle_image d = wrap(disparity, BINOCLE_PIXEL_FLOAT32);
     const binocle_image expected = d;
@@ -639,6 +898,7 @@ void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispar
 }
 
 std::pair<int32_t, int32_t> Matcher::disparityRange() {
+    if (helper_) return helper_->disparityRange();
     int32_t mn = 0, num = 0;
     if (!api_->disparity_range) return {0, 0};
     int32_t rc = api_->disparity_range(handle_, &mn, &num);

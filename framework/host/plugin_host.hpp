@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
-// The plugin host: finds plugin files, loads them with Boost.DLL, checks their ABI
-// before anything else, and wraps their C tables in C++ objects that throw
-// binocle::PluginError with the plugin's own message when a call fails.
+// The plugin host: finds plugin files (binocle_<name>.so) on a safe search path, loads
+// them with Boost.DLL (RTLD_NOW), checks their ABI and settings tables before calling
+// anything else, and wraps their C tables in C++ objects that throw
+// binocle::PluginError with the plugin's own message when a call fails. A matcher may
+// run in a helper process instead (IsolationOptions, host/isolation.hpp).
 #pragma once
 
 #include "core/error.hpp"
 
 #include <binocle/abi.h>
 
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -30,10 +33,22 @@ struct PluginRecord {
     std::string name, version, description;
     int32_t kind = 0;
     uint32_t abi_version = 0, api_version = 0;
+    // The host's own full-size copy of the plugin's table: the bytes the plugin declared
+    // (header.struct_size), zeros after them, so that an entry a plugin built against an
+    // older API lacks reads as NULL (absent) and one a newer plugin appended is never read.
     const binocle_plugin_header *table = nullptr;
+    std::shared_ptr<const void> tableStorage;
     std::shared_ptr<boost::dll::shared_library> library; // keeps the code loaded
     std::vector<binocle_param_desc> params() const;
 };
+
+// The least table size the host accepts for a kind at an API version: the end of the
+// last entry that version defines. Frozen per version; 0 for an unknown kind or version.
+size_t leastTableSize(int32_t kind, uint32_t api_version);
+
+// Why a settings table is unusable ("setting #2 'window_px': default '4' is not odd"),
+// or "" when every setting has a valid name, type and default, and names are unique.
+std::string settingsTableProblem(const binocle_param_desc *params, int32_t count);
 
 // A file that looked like a plugin and was refused, with why.
 struct Refusal {
@@ -41,9 +56,21 @@ struct Refusal {
     std::string reason;
 };
 
+// How a rig runs a plugin: in the process (default), or in a helper process of its own
+// (`isolation: process` in the rig block) that may crash or hang without taking Binocle
+// down. Only matchers honour `process` for now.
+struct IsolationOptions {
+    bool process = false;
+    int32_t call_timeout_ms = 0; // 0: no watchdog
+    bool restart = false;        // restart a helper that crashed or hung
+    int32_t max_restarts = 3;
+};
+
 // Settings as the plugin receives them; owns the strings.
 class ParamValues {
 public:
+    void setIsolation(const IsolationOptions &o) { isolation_ = o; }
+    const IsolationOptions &isolation() const { return isolation_; }
     void setBool(const std::string &name, bool v, bool isExplicit = true);
     void setInt(const std::string &name, int64_t v, bool isExplicit = true);
     void setDouble(const std::string &name, double v, bool isExplicit = true);
@@ -54,6 +81,7 @@ public:
     const binocle_param *find(const std::string &name) const;
 
 private:
+    IsolationOptions isolation_;
     std::vector<binocle_param> values_;
     std::vector<std::shared_ptr<std::string>> strings_; // shared: copies keep pointers valid
     binocle_param &slot(const std::string &name);
@@ -123,19 +151,32 @@ private:
     std::shared_ptr<binocle_source> handle_;
 };
 
+class MatcherHelper;
+
 class Matcher : public PluginInstanceBase {
 public:
+    // In this process, or in a helper process when params.isolation().process.
     Matcher(const PluginRecord &record, const ParamValues &params);
     ~Matcher();
-    // Returns a CV_32F disparity (host-allocated), invalid pixels <= 0.
+    // Returns a CV_32F disparity (host-allocated), invalid pixels <= 0. Disparities that
+    // are not finite or exceed the image width are made invalid and counted.
     cv::Mat compute(const cv::Mat &left, const cv::Mat &right);
     // The same into `disparity`, whose buffer is reused when it has the size already.
     void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity);
     std::pair<int32_t, int32_t> disparityRange();
+    // Runs the plugin's compute into `disparity` (CV_32F, left's size), checking that it
+    // kept the host's image description; no clean-up of the values.
+    void computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity);
+    // Disparities made invalid so far because they were not finite or absurd.
+    uint64_t invalidatedDisparities() const { return invalidated_; }
+    bool isolated() const { return helper_ != nullptr; }
 
 private:
     const binocle_matcher_api *api_;
     binocle_matcher *handle_ = nullptr;
+    std::unique_ptr<MatcherHelper> helper_;
+    uint64_t invalidated_ = 0;
+    bool warnedInvalid_ = false;
 };
 
 class CloudTransform : public PluginInstanceBase {
@@ -161,33 +202,51 @@ private:
     binocle_evaluator *handle_ = nullptr;
 };
 
+enum class ScanMode {
+    InProcess, // open every file in this process (a crashing constructor takes it down)
+    Isolated   // examine each file in a short-lived child first; open only those that pass
+};
+
 class PluginHost {
 public:
     // $BINOCLE_PLUGIN_PATH (':'-separated), then <prefix>/lib/binocle/plugins next to
-    // the running executable, then the build tree's plugin folder.
+    // the running executable (the build tree mirrors that layout). No path is compiled in.
     static std::vector<std::string> defaultSearchPath();
 
     explicit PluginHost(std::vector<std::string> searchPath = defaultSearchPath());
     ~PluginHost();
 
-    // Looks at every binocle_*.so in the search path (first folder wins for a name).
-    void scan();
+    // Looks at every binocle_*.so in the search path (first folder wins for a file name).
+    // Isolated: a file whose code crashes or hangs at load (child_timeout_ms) is refused
+    // with the signal or the timeout, and the scan goes on.
+    void scan(ScanMode mode = ScanMode::InProcess, int32_t child_timeout_ms = 2000) const;
     // Loads one file; throws binocle::Error naming the file and the reason.
     const PluginRecord &load(const std::string &path);
 
-    const std::vector<PluginRecord> &plugins() const { return plugins_; }
+    // Records stay where they are while more plugins are opened (a deque).
+    const std::deque<PluginRecord> &plugins() const { return plugins_; }
     const std::vector<Refusal> &refused() const { return refused_; }
     const std::vector<std::string> &searchPath() const { return searchPath_; }
-    // nullptr if absent (or of another kind when kind != 0).
+    // Among the files opened so far; nullptr if absent (or of another kind when kind != 0).
     const PluginRecord *find(const std::string &name, int32_t kind = 0) const;
-    // Throws Error "no <kind> plugin named 'x' (found: a, b, c)".
+    // Like find, but opens binocle_<name>.so from the first folder of the search path that
+    // holds it when it is not open yet, and no other file: a rig opens only what it names.
+    // A refusal lands in refused(). The host is a cache of opened files, hence const.
+    const PluginRecord *lookup(const std::string &name, int32_t kind = 0) const;
+    // The file binocle_<name>.so in the first safe folder of the search path that holds
+    // one, without opening it; "" when there is none.
+    std::string locate(const std::string &name) const;
+    // Throws Error "no <kind> plugin named 'x' (found: a, b, c)"; opens the file like lookup.
     const PluginRecord &require(const std::string &name, int32_t kind) const;
 
 private:
     std::vector<std::string> searchPath_;
-    std::vector<PluginRecord> plugins_;
-    std::vector<Refusal> refused_;
-    const PluginRecord &inspect(const std::string &path); // throws with reason
+    mutable std::deque<PluginRecord> plugins_;
+    mutable std::vector<Refusal> refused_;
+    const PluginRecord &inspect(const std::string &path) const; // throws with reason
+    // Folders of the search path that are safe to load from; unsafe ones are refused once.
+    std::vector<std::string> safeFolders() const;
+    bool known(const std::string &canonical) const;
 };
 
 } // namespace binocle

@@ -126,6 +126,16 @@ TEST_F(RigConfigTest, SetOverridesAnyValueAndIsNamedInErrors) {
     EXPECT_THROW(loadRig(write(rig()), {Override::parse("transforms.7.x=1")}, *host_), Error);
 }
 
+TEST_F(RigConfigTest, AWholeBlockSwappedWithSetIsLocatedOnTheCommandLine) {
+    const std::string set = "matcher={plugin: bm, block_size: 4}";
+    RigConfig r = loadRig(write(rig()), {Override::parse("matcher={plugin: bm, block_size: 7}")}, *host_);
+    EXPECT_EQ(r.matcher.plugin, "bm");
+    EXPECT_EQ(r.matcher.params.find("block_size")->i, 7);
+    const std::string err = errorOf(rig(), {Override::parse(set)});
+    EXPECT_NE(err.find("command line --set " + set + ": matcher.block_size"), std::string::npos) << err;
+    EXPECT_EQ(err.find("rig.yaml:"), std::string::npos) << err;
+}
+
 TEST_F(RigConfigTest, SwappingBmForSgbmIsOneLine) {
     const std::string sgbm = rig("  plugin: sgbm\n  num_disparities: 64\n  block_size: 5\n");
     std::string bm = sgbm;

@@ -52,8 +52,8 @@ TEST(PluginsCommand, ListsAcceptedAndRefusedFixtures) {
     EXPECT_THAT(refused, HasSubstr("  " + fixturePath("null_entries") + ": plugin 'null_entries' leaves mandatory entries NULL: compute"));
     EXPECT_THAT(refused, HasSubstr("  " + fixturePath("small_header") + ": table size 8 is smaller than the plugin header"));
     EXPECT_THAT(refused, HasSubstr("  " + fixturePath("short_table") + ": table size"));
-    EXPECT_THAT(refused, HasSubstr("  " + fixturePath("mock_matcher_duplicate") + ": plugin name 'mock_matcher' is already provided by " +
-                                   fixturePath("mock_matcher")));
+    EXPECT_THAT(refused, HasSubstr("  " + fixturePath("mock_matcher_duplicate") +
+                                   ": declares the name 'mock_matcher' but its file is binocle_mock_matcher_duplicate.so"));
 }
 
 TEST(PluginsCommand, LoadOfARefusedFileFailsNamingIt) {

@@ -242,7 +242,8 @@ TEST(MockPlugins, MatcherWritesConstantOrShiftedDisparity) {
 }
 
 TEST(MockPlugins, PureCMatcherWorksThroughTheHost) {
-    const cv::Mat left(5, 9, CV_8UC3, cv::Scalar(1, 2, 3)), right = left.clone();
+    // Wider than 12.5 px: a larger disparity than the image width is made invalid.
+    const cv::Mat left(5, 20, CV_8UC3, cv::Scalar(1, 2, 3)), right = left.clone();
     Matcher byDefault = makeInstance<Matcher>("c_matcher", BINOCLE_KIND_MATCHER);
     EXPECT_EQ(cv::countNonZero(byDefault.compute(left, right) != 8.0f), 0);
     Matcher set = makeInstance<Matcher>("c_matcher", BINOCLE_KIND_MATCHER, "{disparity_px: 12.5}");

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: MIT
+// `binocle plugin-check` as an author runs it: the mock fixtures pass, every broken
+// fixture fails with its reason (and the battery goes on past a crash or a hang), and the
+// JUnit report says the same.
+#include "host/fixture_host.hpp"
+
+namespace binocle::test {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+ProcessResult check(const std::vector<std::string> &args) {
+    std::vector<std::string> all{"plugin-check"};
+    all.insert(all.end(), args.begin(), args.end());
+    return runBinocle(all, BINOCLE_TEST_PLUGIN_DIR);
+}
+
+void expectFailure(const ProcessResult &r, const std::string &line) {
+    ASSERT_TRUE(r.exited) << "plugin-check was killed by signal " << r.signal << "\n" << r.err;
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_THAT(r.out, HasSubstr(line)) << r.err;
+}
+
+TEST(PluginCheck, WorkingFixturesOfEveryKindPass) {
+    for (const char *name : {"mock_matcher", "c_matcher", "mock_source", "mock_transform", "mock_evaluator", "frozen_source"}) {
+        const ProcessResult r = check({name});
+        ASSERT_TRUE(r.exited) << name << "\n" << r.err;
+        EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.out << r.err;
+        EXPECT_THAT(r.out, Not(HasSubstr("FAIL"))) << name;
+    }
+}
+
+TEST(PluginCheck, SourceCasesCoverTheLendingRules) {
+    const ProcessResult r = check({"mock_source", "--set", "frames=5"});
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    for (const char *c : {"PASS  create_destroy", "PASS  grab_before_start", "PASS  lend_release_accounting: 4 frames lent at once",
+                          "PASS  release_from_another_thread", "PASS  busy", "PASS  end_of_stream: END_OF_STREAM after 5 frames"})
+        EXPECT_THAT(r.out, HasSubstr(c));
+}
+
+TEST(PluginCheck, ThrowingMatcherFailsWithItsMessage) {
+    expectFailure(check({"throws"}), "FAIL  compute_in_host_buffers: compute on a textured 320x240 pair failed "
+                                     "(BINOCLE_ERR_INTERNAL: deliberate failure from throws plugin)");
+}
+
+TEST(PluginCheck, CrashAndHangInComputeFailTheirCasesAndTheBatteryGoesOn) {
+    ProcessResult r = check({"faulty_matcher"});
+    expectFailure(r, "FAIL  compute_in_host_buffers: crashed: killed by signal 11 (SIGSEGV)");
+    EXPECT_THAT(r.out, HasSubstr("PASS  create_destroy")); // the cases around it ran
+    r = check({"faulty_matcher", "--set", "fault=hang", "--timeout-ms", "3000"});
+    expectFailure(r, "FAIL  compute_in_host_buffers: did not finish within 3000 ms (a call hangs?); killed");
+    r = check({"faulty_matcher", "--set", "fault=nan"});
+    expectFailure(r, "disparities are not finite (write BINOCLE_INVALID_DISPARITY instead)");
+}
+
+TEST(PluginCheck, WritesOutsideTheHostsBuffersAreCaught) {
+    expectFailure(check({"overrun_matcher"}), "FAIL  compute_in_host_buffers: crashed: killed by signal 11 (SIGSEGV)");
+    expectFailure(check({"overrun_matcher", "--set", "target=left"}), "FAIL  compute_in_host_buffers: crashed: killed by signal 11");
+    expectFailure(check({"garbage_matcher"}), "changed the host's disparity image description instead of writing into it");
+    expectFailure(check({"garbage_transform"}), "apply returned a garbage cloud");
+}
+
+TEST(PluginCheck, BrokenSourcesFail) {
+    expectFailure(check({"throws_source"}), "deliberate failure from throws plugin");
+    expectFailure(check({"garbage_source"}), "FAIL  lend_release_accounting: grab lent an invalid image");
+}
+
+TEST(PluginCheck, EveryFixtureTheHostRefusesFailsAtLoadWithTheSameReason) {
+    ASSERT_GE(fixtureHost().refused().size(), 10u);
+    for (const auto &refusal : fixtureHost().refused())
+        expectFailure(check({refusal.path}), "FAIL  load: " + refusal.reason);
+}
+
+TEST(PluginCheck, FilesWhoseCodeFailsAtLoadFailWithTheSignalOrTheTimeout) {
+    const std::string unsafe = std::string(BINOCLE_TEST_UNSAFE_PLUGIN_DIR) + "/binocle_";
+    expectFailure(check({unsafe + "crash_at_load.so"}), "FAIL  load: crashed while loading (its code runs at load): killed by signal 11 (SIGSEGV)");
+    expectFailure(check({unsafe + "hang_at_load.so", "--timeout-ms", "3000"}), "FAIL  load: still loading after 3000 ms");
+    expectFailure(check({unsafe + "undefined_symbol.so"}), "undefined symbol: binocle_fixture_symbol_nobody_defines");
+}
+
+TEST(PluginCheck, WritesAJUnitReport) {
+    TempDir dir;
+    const std::string xml = dir.str("report.xml");
+    const ProcessResult r = check({"faulty_matcher", "--junit", xml});
+    EXPECT_EQ(r.exit_code, 1);
+    const std::string text = readAll(xml);
+    EXPECT_THAT(text, HasSubstr("<testsuite name=\"plugin_check.matcher.faulty_matcher\""));
+    EXPECT_THAT(text, HasSubstr("<testcase classname=\"plugin_check.matcher.faulty_matcher\" name=\"create_destroy\""));
+    EXPECT_THAT(text, HasSubstr("name=\"compute_in_host_buffers\""));
+    EXPECT_THAT(text, HasSubstr("<failure message=\"crashed: killed by signal 11 (SIGSEGV)\"/>"));
+}
+
+TEST(PluginCheck, AnUnknownNameSaysWhereItLooked) {
+    const ProcessResult r = check({"not_a_plugin"});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_THAT(r.err, HasSubstr("no file binocle_not_a_plugin.so in the search path (" BINOCLE_TEST_PLUGIN_DIR));
+}
+
+} // namespace
+} // namespace binocle::test

@@ -1,0 +1,544 @@
+// SPDX-License-Identifier: MIT
+// Binocle SDK: write a plugin as an ordinary C++ class and export it with one macro.
+//
+//   class MyMatcher : public binocle::sdk::Matcher {
+//   public:
+//       static std::vector<binocle_param_desc> parameters() {
+//           return {binocle::sdk::Param::integer("window_px", "5").min(1).odd()
+//                       .help("matching window").unit("px")};
+//       }
+//       MyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host);
+//       void compute(const binocle_image &l, const binocle_image &r, binocle_image &d) override;
+//   };
+//   BINOCLE_EXPORT_MATCHER(MyMatcher, "my_matcher", "1.0.0", "What it does")
+//
+// Exceptions thrown by the class are caught at the boundary and turned into a result
+// code (binocle::sdk::Error carries its own) and a message the host can ask for.
+// This header needs only the C++17 standard library.
+#pragma once
+
+#include <binocle/abi.h>
+
+#include <cstring>
+#include <exception>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace binocle::sdk {
+
+// An error with a result code; anything else thrown becomes BINOCLE_ERR_INTERNAL.
+class Error : public std::runtime_error {
+public:
+    Error(binocle_result code, const std::string &message) : std::runtime_error(message), code_(code) {}
+    binocle_result code() const noexcept { return code_; }
+
+private:
+    binocle_result code_;
+};
+
+// ---- Settings -------------------------------------------------------------------
+
+// Builder for binocle_param_desc. All strings must be literals (static storage).
+class Param {
+public:
+    static Param boolean(const char *name, bool def) { return Param(name, BINOCLE_PARAM_BOOL, def ? "true" : "false"); }
+    static Param integer(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT, def); }
+    static Param real(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE, def); }
+    static Param string(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_STRING, def); }
+    static Param path(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_PATH, def); }
+    static Param yaml(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_YAML, def); }
+    static Param intList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT_LIST, def); }
+    static Param realList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE_LIST, def); }
+    // choices: "a|b|c"
+    static Param choice(const char *name, const char *def, const char *choices) {
+        Param p(name, BINOCLE_PARAM_ENUM, def);
+        p.d_.choices = choices;
+        return p;
+    }
+    // A setting without default that the YAML must give.
+    Param &required() { d_.flags |= BINOCLE_PARAM_FLAG_REQUIRED; d_.default_value = nullptr; return *this; }
+    Param &min(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MIN; d_.min = v; return *this; }
+    Param &max(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MAX; d_.max = v; return *this; }
+    Param &odd() { d_.flags |= BINOCLE_PARAM_FLAG_ODD; return *this; }
+    Param &multipleOf(int64_t m) { d_.multiple_of = m; return *this; }
+    Param &unit(const char *u) { d_.unit = u; return *this; }
+    Param &help(const char *h) { d_.help = h; return *this; }
+    operator binocle_param_desc() const { return d_; } // NOLINT: meant to convert
+
+private:
+    Param(const char *name, int32_t type, const char *def) {
+        d_.name = name;
+        d_.type = type;
+        d_.default_value = def;
+        d_.unit = "";
+        d_.help = "";
+    }
+    binocle_param_desc d_{};
+};
+
+// Read access to validated settings, by name.
+class Params {
+public:
+    Params(const binocle_param *params, int32_t count) {
+        for (int32_t i = 0; i < count; ++i) byName_[params[i].name] = params[i];
+    }
+    bool has(const std::string &name) const { return byName_.count(name) != 0; }
+    // True when the user set the value (YAML or --set), false for defaults.
+    bool isExplicit(const std::string &name) const { return get(name).explicit_ != 0; }
+    int64_t integer(const std::string &name) const { return get(name).i; }
+    bool boolean(const std::string &name) const { return get(name).i != 0; }
+    double real(const std::string &name) const {
+        const binocle_param &p = get(name);
+        return p.type == BINOCLE_PARAM_INT ? static_cast<double>(p.i) : p.d;
+    }
+    // STRING, ENUM, PATH, YAML and lists (as YAML text).
+    std::string string(const std::string &name) const {
+        const char *s = get(name).s;
+        return s ? s : "";
+    }
+
+private:
+    const binocle_param &get(const std::string &name) const {
+        auto it = byName_.find(name);
+        if (it == byName_.end())
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "no setting named '" + name + "' (plugin bug: not declared)");
+        return it->second;
+    }
+    std::map<std::string, binocle_param> byName_;
+};
+
+// ---- Host services -----------------------------------------------------------------
+
+class Host {
+public:
+    explicit Host(const binocle_host *h) : h_(h) {}
+    void log(int32_t level, const std::string &msg) const {
+        if (h_ && h_->log) h_->log(h_->context, level, msg.c_str());
+    }
+    void info(const std::string &msg) const { log(BINOCLE_LOG_INFO, msg); }
+    void warning(const std::string &msg) const { log(BINOCLE_LOG_WARNING, msg); }
+    void metric(const std::string &name, double value, const std::string &unit = "") const {
+        if (h_ && h_->report_metric) h_->report_metric(h_->context, name.c_str(), value, unit.c_str());
+    }
+    void text(const std::string &name, const std::string &text) const {
+        if (h_ && h_->report_text) h_->report_text(h_->context, name.c_str(), text.c_str());
+    }
+
+private:
+    const binocle_host *h_;
+};
+
+// ---- Images --------------------------------------------------------------------------
+
+inline int bytesPerPixel(int32_t format) {
+    switch (format) {
+    case BINOCLE_PIXEL_GRAY8: return 1;
+    case BINOCLE_PIXEL_GRAY16: return 2;
+    case BINOCLE_PIXEL_BGR8:
+    case BINOCLE_PIXEL_RGB8: return 3;
+    case BINOCLE_PIXEL_FLOAT32: return 4;
+    default: return 0;
+    }
+}
+
+inline binocle_image makeImage(int32_t width, int32_t height, int32_t format, void *data, int32_t stride_bytes = 0) {
+    binocle_image im{};
+    im.width = width;
+    im.height = height;
+    im.format = format;
+    im.stride_bytes = stride_bytes > 0 ? stride_bytes : width * bytesPerPixel(format);
+    im.data = data;
+    return im;
+}
+
+// ---- StereoSource ----------------------------------------------------------------------
+
+// A frame a C++ source hands out. The SDK lends it to the host and destroys it when
+// the host releases it: keep the pixel memory alive in `owner` (a vector, a cv::Mat,
+// a driver buffer ...) and put any give-back action (re-queue a V4L2 buffer) in
+// `onRelease`.
+struct Frame {
+    uint64_t sequence = 0;
+    int64_t timestamp_left_ns = 0;
+    int64_t timestamp_right_ns = 0;
+    binocle_image left{};
+    binocle_image right{};
+    std::vector<std::pair<std::string, binocle_image>> extras;
+    std::string metadata; // YAML, may be empty
+    std::shared_ptr<void> owner;
+    std::function<void()> onRelease;
+
+    Frame() = default;
+    Frame(const Frame &) = delete;
+    Frame &operator=(const Frame &) = delete;
+    ~Frame() {
+        if (onRelease) onRelease();
+    }
+};
+
+class StereoSource {
+public:
+    virtual ~StereoSource() = default;
+    virtual void start() {}
+    virtual void stop() {}
+    // Next pair; throw Error(BINOCLE_ERR_END_OF_STREAM, ...) when exhausted,
+    // Error(BINOCLE_ERR_TIMEOUT, ...) when nothing came in time.
+    virtual std::unique_ptr<Frame> grab(int32_t timeout_ms) = 0;
+    // OpenCV FileStorage YAML text, empty when unknown.
+    virtual std::string calibration() { return {}; }
+    // YAML text of stream statistics.
+    virtual std::string statistics() { return {}; }
+    // Hide this in a derived class to list devices (YAML sequence of maps with id, description).
+    static std::string enumerateDevices(Host &) { return "[]"; }
+};
+
+class Matcher {
+public:
+    virtual ~Matcher() = default;
+    virtual void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) = 0;
+    // {min_disparity, num_disparities}
+    virtual std::pair<int32_t, int32_t> disparityRange() const { return {0, 0}; }
+};
+
+class CloudTransform {
+public:
+    virtual ~CloudTransform() = default;
+    virtual void apply(binocle_cloud &cloud) = 0;
+};
+
+class Evaluator {
+public:
+    virtual ~Evaluator() = default;
+    virtual void evaluate(const binocle_eval_input &input) = 0;
+    virtual void finish() {}
+};
+
+// ---- Boundary adaptors (implementation detail of the export macros) --------------------
+namespace detail {
+
+inline std::string &createError() {
+    thread_local std::string message;
+    return message;
+}
+
+// Runs f, turning any exception into a result code and a message stored in `error`.
+template <class F>
+binocle_result guard(std::string &error, F &&f) noexcept {
+    try {
+        f();
+        return BINOCLE_OK;
+    } catch (const Error &e) {
+        try { error = e.what(); } catch (...) {}
+        return e.code() == BINOCLE_OK ? BINOCLE_ERR_INTERNAL : e.code();
+    } catch (const std::exception &e) {
+        try { error = e.what(); } catch (...) {}
+        return BINOCLE_ERR_INTERNAL;
+    } catch (...) {
+        try { error = "unknown exception"; } catch (...) {}
+        return BINOCLE_ERR_INTERNAL;
+    }
+}
+
+template <class T>
+struct Instance {
+    using Impl = T;
+    explicit Instance(const binocle_host *h) : hostView(h) {}
+    Host hostView;
+    std::unique_ptr<T> impl;
+    std::string error;
+};
+
+template <class T>
+const std::vector<binocle_param_desc> &paramsOf() {
+    static const std::vector<binocle_param_desc> p = T::parameters();
+    return p;
+}
+
+template <class Inst, class Handle>
+binocle_result create(const binocle_param *params, int32_t n, const binocle_host *host, Handle **out) noexcept {
+    if (!out) return BINOCLE_ERR_INVALID_ARGUMENT;
+    *out = nullptr;
+    return guard(createError(), [&] {
+        auto inst = std::make_unique<Inst>(host);
+        Params p(params, n);
+        inst->impl = std::make_unique<typename Inst::Impl>(p, inst->hostView);
+        *out = reinterpret_cast<Handle *>(inst.release());
+    });
+}
+
+template <class Inst, class Handle>
+void destroy(Handle *h) noexcept {
+    try { delete reinterpret_cast<Inst *>(h); } catch (...) {}
+}
+
+template <class Inst, class Handle>
+const char *lastError(Handle *h) noexcept {
+    if (!h) return createError().c_str();
+    return reinterpret_cast<Inst *>(h)->error.c_str();
+}
+
+template <class T, class Handle>
+Instance<T> &inst(Handle *h) {
+    return *reinterpret_cast<Instance<T> *>(h);
+}
+
+// Source instances also keep the frames they have lent.
+template <class T>
+struct SourceInstance : Instance<T> {
+    using Instance<T>::Instance;
+    struct Lent {
+        std::unique_ptr<Frame> frame;
+        std::vector<binocle_named_image> extras;
+    };
+    std::mutex lentMutex;
+    std::map<uint64_t, Lent> lent;
+    uint64_t nextId = 1;
+    std::string calibration, statistics;
+    bool calibrationRead = false;
+};
+
+template <class T>
+SourceInstance<T> &src(binocle_source *h) {
+    return *reinterpret_cast<SourceInstance<T> *>(h);
+}
+
+template <class T>
+binocle_result sourceGrab(binocle_source *h, int32_t timeout_ms, binocle_stereo_frame *out) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] {
+        if (!out) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "grab: frame is NULL");
+        std::unique_ptr<Frame> f = s.impl->grab(timeout_ms);
+        if (!f) throw Error(BINOCLE_ERR_INTERNAL, "grab returned no frame");
+        typename SourceInstance<T>::Lent lent;
+        for (auto &e : f->extras) lent.extras.push_back(binocle_named_image{e.first.c_str(), e.second});
+        binocle_stereo_frame v{};
+        v.struct_size = out->struct_size < sizeof(v) ? out->struct_size : static_cast<uint32_t>(sizeof(v));
+        v.sequence = f->sequence;
+        v.timestamp_left_ns = f->timestamp_left_ns;
+        v.timestamp_right_ns = f->timestamp_right_ns;
+        v.left = f->left;
+        v.right = f->right;
+        v.extras = lent.extras.empty() ? nullptr : lent.extras.data();
+        v.extra_count = static_cast<int32_t>(lent.extras.size());
+        v.metadata = f->metadata.empty() ? nullptr : f->metadata.c_str();
+        lent.frame = std::move(f);
+        {
+            std::lock_guard<std::mutex> lock(s.lentMutex);
+            v.frame_id = s.nextId++;
+            s.lent.emplace(v.frame_id, std::move(lent));
+        }
+        std::memcpy(out, &v, v.struct_size ? v.struct_size : sizeof(v));
+    });
+}
+
+template <class T>
+binocle_result sourceRelease(binocle_source *h, uint64_t id) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] {
+        typename SourceInstance<T>::Lent gone;
+        {
+            std::lock_guard<std::mutex> lock(s.lentMutex);
+            auto it = s.lent.find(id);
+            if (it == s.lent.end()) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "release of a frame that is not lent: id " + std::to_string(id));
+            gone = std::move(it->second);
+            s.lent.erase(it);
+        }
+        // `gone` is destroyed here, outside the lock: onRelease runs now.
+    });
+}
+
+template <class T>
+binocle_result sourceStart(binocle_source *h) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] { s.impl->start(); });
+}
+
+template <class T>
+binocle_result sourceStop(binocle_source *h) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] { s.impl->stop(); });
+}
+
+template <class T>
+binocle_result sourceCalibration(binocle_source *h, const char **yaml) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] {
+        if (!yaml) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "calibration: yaml is NULL");
+        if (!s.calibrationRead) {
+            s.calibration = s.impl->calibration();
+            s.calibrationRead = true;
+        }
+        *yaml = s.calibration.empty() ? nullptr : s.calibration.c_str();
+    });
+}
+
+template <class T>
+binocle_result sourceStatistics(binocle_source *h, const char **yaml) noexcept {
+    auto &s = src<T>(h);
+    return guard(s.error, [&] {
+        if (!yaml) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "statistics: yaml is NULL");
+        s.statistics = s.impl->statistics();
+        *yaml = s.statistics.empty() ? nullptr : s.statistics.c_str();
+    });
+}
+
+template <class T>
+binocle_result sourceEnumerate(const binocle_host *host, const char **yaml) noexcept {
+    static thread_local std::string text;
+    return guard(createError(), [&] {
+        if (!yaml) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "enumerate_devices: yaml is NULL");
+        Host hv(host);
+        text = T::enumerateDevices(hv);
+        *yaml = text.c_str();
+    });
+}
+
+template <class T>
+binocle_result matcherCompute(binocle_matcher *h, const binocle_image *l, const binocle_image *r,
+                              binocle_image *d) noexcept {
+    auto &s = inst<T>(h);
+    return guard(s.error, [&] {
+        if (!l || !r || !d) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "compute: NULL image");
+        s.impl->compute(*l, *r, *d);
+    });
+}
+
+template <class T>
+binocle_result matcherRange(binocle_matcher *h, int32_t *mn, int32_t *num) noexcept {
+    auto &s = inst<T>(h);
+    return guard(s.error, [&] {
+        auto r = s.impl->disparityRange();
+        if (mn) *mn = r.first;
+        if (num) *num = r.second;
+    });
+}
+
+template <class T>
+binocle_result transformApply(binocle_cloud_transform *h, binocle_cloud *c) noexcept {
+    auto &s = inst<T>(h);
+    return guard(s.error, [&] {
+        if (!c) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "apply: cloud is NULL");
+        s.impl->apply(*c);
+    });
+}
+
+template <class T>
+binocle_result evaluatorEvaluate(binocle_evaluator *h, const binocle_eval_input *in) noexcept {
+    auto &s = inst<T>(h);
+    return guard(s.error, [&] {
+        if (!in) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "evaluate: input is NULL");
+        s.impl->evaluate(*in);
+    });
+}
+
+template <class T>
+binocle_result evaluatorFinish(binocle_evaluator *h) noexcept {
+    auto &s = inst<T>(h);
+    return guard(s.error, [&] { s.impl->finish(); });
+}
+
+inline binocle_plugin_header header(uint32_t size, int32_t kind, const char *name, const char *version,
+                                    const char *description) {
+    return binocle_plugin_header{size, BINOCLE_ABI_VERSION, BINOCLE_API_VERSION, kind, name, version, description};
+}
+
+template <class T>
+const binocle_source_api *sourceTable(const char *name, const char *version, const char *description) {
+    static const binocle_source_api table = [&] {
+        binocle_source_api t{};
+        t.header = header(sizeof(t), BINOCLE_KIND_STEREO_SOURCE, name, version, description);
+        t.params = paramsOf<T>().data();
+        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
+        t.create = &create<SourceInstance<T>, binocle_source>;
+        t.destroy = &destroy<SourceInstance<T>, binocle_source>;
+        t.last_error = &lastError<SourceInstance<T>, binocle_source>;
+        t.start = &sourceStart<T>;
+        t.stop = &sourceStop<T>;
+        t.grab = &sourceGrab<T>;
+        t.release_frame = &sourceRelease<T>;
+        t.calibration = &sourceCalibration<T>;
+        t.statistics = &sourceStatistics<T>;
+        t.enumerate_devices = &sourceEnumerate<T>;
+        return t;
+    }();
+    return &table;
+}
+
+template <class T>
+const binocle_matcher_api *matcherTable(const char *name, const char *version, const char *description) {
+    static const binocle_matcher_api table = [&] {
+        binocle_matcher_api t{};
+        t.header = header(sizeof(t), BINOCLE_KIND_MATCHER, name, version, description);
+        t.params = paramsOf<T>().data();
+        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
+        t.create = &create<Instance<T>, binocle_matcher>;
+        t.destroy = &destroy<Instance<T>, binocle_matcher>;
+        t.last_error = &lastError<Instance<T>, binocle_matcher>;
+        t.compute = &matcherCompute<T>;
+        t.disparity_range = &matcherRange<T>;
+        return t;
+    }();
+    return &table;
+}
+
+template <class T>
+const binocle_cloud_transform_api *transformTable(const char *name, const char *version, const char *description) {
+    static const binocle_cloud_transform_api table = [&] {
+        binocle_cloud_transform_api t{};
+        t.header = header(sizeof(t), BINOCLE_KIND_CLOUD_TRANSFORM, name, version, description);
+        t.params = paramsOf<T>().data();
+        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
+        t.create = &create<Instance<T>, binocle_cloud_transform>;
+        t.destroy = &destroy<Instance<T>, binocle_cloud_transform>;
+        t.last_error = &lastError<Instance<T>, binocle_cloud_transform>;
+        t.apply = &transformApply<T>;
+        return t;
+    }();
+    return &table;
+}
+
+template <class T>
+const binocle_evaluator_api *evaluatorTable(const char *name, const char *version, const char *description) {
+    static const binocle_evaluator_api table = [&] {
+        binocle_evaluator_api t{};
+        t.header = header(sizeof(t), BINOCLE_KIND_EVALUATOR, name, version, description);
+        t.params = paramsOf<T>().data();
+        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
+        t.create = &create<Instance<T>, binocle_evaluator>;
+        t.destroy = &destroy<Instance<T>, binocle_evaluator>;
+        t.last_error = &lastError<Instance<T>, binocle_evaluator>;
+        t.evaluate = &evaluatorEvaluate<T>;
+        t.finish = &evaluatorFinish<T>;
+        return t;
+    }();
+    return &table;
+}
+
+} // namespace detail
+} // namespace binocle::sdk
+
+// The init symbol: returns the plugin's table whatever the host asks, so that the host
+// can name both versions when they differ.
+#define BINOCLE_DETAIL_EXPORT(TABLE_EXPR)                                                             \
+    extern "C" BINOCLE_PLUGIN_EXPORT const binocle_plugin_header *binocle_plugin_init(uint32_t, uint32_t) { \
+        try {                                                                                         \
+            return &(TABLE_EXPR)->header;                                                             \
+        } catch (...) {                                                                               \
+            return nullptr;                                                                           \
+        }                                                                                             \
+    }
+
+#define BINOCLE_EXPORT_SOURCE(CLASS, NAME, VERSION, DESCRIPTION) \
+    BINOCLE_DETAIL_EXPORT(::binocle::sdk::detail::sourceTable<CLASS>(NAME, VERSION, DESCRIPTION))
+#define BINOCLE_EXPORT_MATCHER(CLASS, NAME, VERSION, DESCRIPTION) \
+    BINOCLE_DETAIL_EXPORT(::binocle::sdk::detail::matcherTable<CLASS>(NAME, VERSION, DESCRIPTION))
+#define BINOCLE_EXPORT_CLOUD_TRANSFORM(CLASS, NAME, VERSION, DESCRIPTION) \
+    BINOCLE_DETAIL_EXPORT(::binocle::sdk::detail::transformTable<CLASS>(NAME, VERSION, DESCRIPTION))
+#define BINOCLE_EXPORT_EVALUATOR(CLASS, NAME, VERSION, DESCRIPTION) \
+    BINOCLE_DETAIL_EXPORT(::binocle::sdk::detail::evaluatorTable<CLASS>(NAME, VERSION, DESCRIPTION))
