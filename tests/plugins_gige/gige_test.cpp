@@ -636,6 +636,63 @@ TEST(GigeEquality, SameDisparityFromSimReplayAndTwoGigeCameras) {
     }
 }
 
+// ---- External fake cameras: packets between two processes, as from real cameras ------------
+
+using binocle::test::ExternalFakeCamera;
+
+struct TransportFigures {
+    int pairs = 0;
+    double seconds = 0;
+    int64_t incomplete = 0, skipped = 0, unpaired = 0, missingPackets = 0;
+    std::string error; // the grab that failed, if one did
+};
+
+// Grabs `pairs` pairs from the two external cameras (free running at `rateHz`, 640x480 Mono8),
+// giving each pair back at once, and returns what the source counted.
+TransportFigures grabFromExternal(const std::string &extra, int pairs, double rateHz, double maxSeconds = 10) {
+    auto src = openGige("{" + kCameras + ", width: 640, height: 480, trigger: free_run, frame_rate_hz: " + std::to_string(rateHz) +
+                        (extra.empty() ? "" : ", " + extra) + "}");
+    src->start();
+    TransportFigures f;
+    const auto t0 = Clock::now();
+    for (; f.pairs < pairs && msSince(t0) < maxSeconds * 1000; ++f.pairs) {
+        try {
+            if (!src->grab(3000)) break;
+        } catch (const PluginError &e) {
+            f.error = e.what();
+            break;
+        }
+    }
+    f.seconds = msSince(t0) / 1000;
+    src->stop();
+    const YAML::Node st = statisticsOf(*src);
+    for (int c = 0; c < 2; ++c) {
+        f.incomplete += st["cameras"][c]["incomplete_images"].as<int64_t>();
+        f.skipped += st["cameras"][c]["skipped_frame_ids"].as<int64_t>();
+        f.unpaired += st["cameras"][c]["unpaired"].as<int64_t>();
+        f.missingPackets += st["cameras"][c]["missing_packets"].as<int64_t>();
+    }
+    return f;
+}
+
+TEST(GigeExternal, DefaultTransportHoldsTwoExternalCamerasAtCameraRate) {
+    ExternalFakeCamera left(kLeftAddress, "EXTL0001"), right(kRightAddress, "EXTR0001");
+    std::string why;
+    if (!left.start(&why) || !right.start(&why)) GTEST_SKIP() << why;
+    // The kernel's default receive buffer (what Aravis keeps unless told), then the plugin's
+    // defaults; same cameras, same run.
+    const TransportFigures old = grabFromExternal("socket_buffer_bytes: 212992", 60, 30, 4);
+    const TransportFigures now = grabFromExternal("exposure_us: 0", 90, 30); // 0 = keep, even when written
+    for (const auto &[name, f] : {std::pair<const char *, TransportFigures>{"208 KiB socket buffer", old}, {"defaults", now}})
+        std::printf("[ figures  ] external cameras, 640x480 Mono8 at 30 fps, %s: %d pairs in %.2f s (%.1f pairs/s); "
+                    "images incomplete %lld, never received %lld, unpaired %lld; missing packets %lld\n",
+                    name, f.pairs, f.seconds, f.pairs / f.seconds, static_cast<long long>(f.incomplete),
+                    static_cast<long long>(f.skipped), static_cast<long long>(f.unpaired), static_cast<long long>(f.missingPackets));
+    ASSERT_EQ(now.pairs, 90) << now.error;
+    // At most 1 % of the images lost anywhere in the transport (2 cameras x 90 pairs).
+    EXPECT_LE(now.incomplete + now.skipped, 2) << "the default transport loses images at 30 fps";
+}
+
 // ---- Shipped rigs -------------------------------------------------------------------------------
 
 TEST(GigeConfigs, ShippedRigsAreValid) {
