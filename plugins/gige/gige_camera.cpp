@@ -341,11 +341,18 @@ void Camera::configureTransport() {
 void Camera::configureStreamSocket() {
     // Room for as many images as the stream has buffers: a burst that waits for the stream
     // thread is never larger than what the buffers could take anyway.
-    socketBufferBytes_ = settings_.socket_buffer_bytes > 0 ? settings_.socket_buffer_bytes
-                                                           : static_cast<int64_t>(payload_) * settings_.buffers;
-    socketBufferBytes_ = std::min<int64_t>(socketBufferBytes_, G_MAXINT);
     std::ifstream limit("/proc/sys/net/core/rmem_max");
     if (!(limit >> socketBufferLimitBytes_)) socketBufferLimitBytes_ = 0;
+    if (settings_.socket_buffer_bytes > 0) {
+        socketBufferBytes_ = settings_.socket_buffer_bytes;
+    } else {
+        // What the kernel grants, but never less than two images (a warning tells how to
+        // raise the limit then).
+        socketBufferBytes_ = static_cast<int64_t>(payload_) * settings_.buffers;
+        if (socketBufferLimitBytes_ > 0)
+            socketBufferBytes_ = std::min(socketBufferBytes_, std::max(socketBufferLimitBytes_, 2 * static_cast<int64_t>(payload_)));
+    }
+    socketBufferBytes_ = std::min<int64_t>(socketBufferBytes_, G_MAXINT);
     g_object_set(stream_, "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_FIXED, "socket-buffer-size",
                  static_cast<gint>(socketBufferBytes_), "packet-resend",
                  settings_.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS : ARV_GV_STREAM_PACKET_RESEND_NEVER, nullptr);

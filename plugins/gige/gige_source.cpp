@@ -147,13 +147,13 @@ public:
                 .help("a camera that delivers no image this long while it should (free_run, or a software trigger) is lost"),
             Param::boolean("reconnect", true).help("reopen a lost camera in the background when it answers again"),
             Param::integer("retry_interval_ms", "1000").min(10).unit("ms").help("pause between reconnection attempts"),
-            Param::integer("buffers", "8").min(2).max(256).help("stream buffers per camera"),
+            Param::integer("buffers", "16").min(2).max(256).help("stream buffers per camera"),
             Param::integer("packet_size", "0").min(0).unit("bytes")
                 .help("GigE Vision stream packet size; 0 = the largest the path carries (Aravis's test packets)"),
             Param::integer("packet_delay_ns", "0").min(0).unit("ns")
                 .help("pause between two stream packets (GevSCPD), for links that drop bursts; 0 = none"),
             Param::integer("socket_buffer_bytes", "0").min(0).unit("bytes")
-                .help("receive buffer of each stream socket; 0 = room for every stream buffer's image (capped by net.core.rmem_max)"),
+                .help("receive buffer of each stream socket; 0 = room for every stream buffer's image, at most net.core.rmem_max"),
             Param::boolean("packet_resend", true).help("ask the camera to send missing packets again (GigE Vision resend)"),
             Param::boolean("packet_socket", false)
                 .help("receive with Aravis's packet socket (less CPU; a camera reopened while others stream may lose frames)"),
@@ -439,6 +439,7 @@ private:
             const uint64_t last = *slot.lastFrameId;
             if (id > last) slot.skippedIds += id - last - 1;
             else if (last - id > 32768 && last <= 65535) slot.skippedIds += (65535 - last) + (id - 1);
+            else return; // an older frame given up late, or a repeat: nothing skipped, `last` stays
         }
         slot.lastFrameId = id;
     }
