@@ -105,6 +105,11 @@ struct RecordingWriter::Pool {
     std::vector<std::thread> workers;
     std::thread committer;
 
+    ~Pool() {
+        for (int fd : {csvFd, dirFds[0], dirFds[1]})
+            if (fd >= 0) ::close(fd);
+    }
+
     void work() {
         std::unique_lock<std::mutex> lock(mutex);
         for (;;) {
@@ -276,8 +281,6 @@ RecordingWriter::~RecordingWriter() {
     }
     p.jobDone.notify_all();
     p.committer.join();
-    for (int fd : {p.csvFd, p.dirFds[0], p.dirFds[1]})
-        if (fd >= 0) ::close(fd);
 }
 
 bool RecordingWriter::submit(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, cv::Mat left, cv::Mat right,
