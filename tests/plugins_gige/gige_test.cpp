@@ -343,6 +343,23 @@ TEST(Gige, FeaturesAreSetOnTheCameras) {
     }
 }
 
+TEST(Gige, ZeroWrittenOutKeepsTheCamerasValues) {
+    FakeCamera left(kLeftAddress, "LEFT0001"), right(kRightAddress, "RIGHT001");
+    guint32 exposureBefore = 0, periodBefore = 0;
+    arv_fake_camera_read_register(left.fake(), ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, &exposureBefore);
+    arv_fake_camera_read_register(left.fake(), ARV_FAKE_CAMERA_REGISTER_ACQUISITION_FRAME_PERIOD_US, &periodBefore);
+    // The README's "0 = keep", written out as the shipped rigs do.
+    auto src = openGige("{" + kCameras + ", width: 0, height: 0, exposure_us: 0, frame_rate_hz: 0, packet_size: 0}");
+    guint32 exposure = 0, period = 0;
+    arv_fake_camera_read_register(left.fake(), ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, &exposure);
+    arv_fake_camera_read_register(left.fake(), ARV_FAKE_CAMERA_REGISTER_ACQUISITION_FRAME_PERIOD_US, &period);
+    EXPECT_EQ(exposure, exposureBefore);
+    EXPECT_EQ(period, periodBefore);
+    const YAML::Node st = statisticsOf(*src);
+    EXPECT_EQ(st["cameras"][0]["packet_size"].as<int>(), 1400) << "the fake camera's own: it sends no test packets";
+    EXPECT_GE(st["cameras"][0]["socket_buffer_bytes"].as<int64_t>(), 2 * 512 * 512) << "room for two images at least";
+}
+
 // ---- Bad input: errors name the device and the value ---------------------------------------
 
 TEST(GigeBadInput, UnknownCameraIsNamedWithTheCamerasFound) {
