@@ -331,10 +331,8 @@ public:
             s << "    connected: " << (slot->camera ? "true" : "false") << "\n";
             s << "    images: " << slot->images << "\n";
             s << "    unpaired: " << slot->unpaired << "\n";
-            uint64_t incomplete = 0;
-            for (const auto &[name, n] : slot->failures) incomplete += n;
-            s << "    incomplete_images: " << incomplete << "\n";
-            s << "    skipped_frame_ids: " << slot->skippedIds << "\n";
+            s << "    incomplete_images: " << incompleteImages(*slot) << "\n";
+            s << "    skipped_frame_ids: " << skippedIds(*slot) << "\n";
             s << "    completed_buffers: " << c.completed << "\n";
             s << "    failed_buffers: " << c.failed << "\n";
             s << "    underrun_buffers: " << c.underruns << "\n";
@@ -396,7 +394,7 @@ private:
         int attempts = 0;                               // reconnection attempts (mutex_)
         std::string lastAttemptError;                   // (mutex_)
         StreamCounters retired;                         // counters of closed streams
-        uint64_t images = 0, losses = 0, unpaired = 0, skippedIds = 0;
+        uint64_t images = 0, losses = 0, unpaired = 0, idGap = 0;
         std::optional<uint64_t> lastFrameId; // of the current camera
         std::map<std::string, uint64_t> failures;
         std::unique_ptr<TriggerWorker> trigger; // software trigger: of the current camera
@@ -431,17 +429,31 @@ private:
         ++slot.unpaired;
     }
 
-    // Frame ids the camera numbered that never left the stream: every packet lost, or no
-    // free buffer (Aravis's underruns). GVSP 1.x ids run 1..65535, then wrap.
-    static void countSkippedIds(Slot &slot, uint64_t id) {
+    // Frame ids between two complete images, not counted otherwise: the camera numbered
+    // them but they never left the stream (every packet lost, or no free buffer). Only
+    // complete images' ids are trusted: a buffer that lost packets may carry any id.
+    // GVSP 1.x ids run 1..65535, then wrap.
+    static void countIdGap(Slot &slot, uint64_t id) {
         if (id == 0) return;
         if (slot.lastFrameId) {
             const uint64_t last = *slot.lastFrameId;
-            if (id > last) slot.skippedIds += id - last - 1;
-            else if (last - id > 32768 && last <= 65535) slot.skippedIds += (65535 - last) + (id - 1);
-            else return; // an older frame given up late, or a repeat: nothing skipped, `last` stays
+            if (id > last) slot.idGap += id - last - 1;
+            else if (last - id > 32768 && last <= 65535) slot.idGap += (65535 - last) + (id - 1);
+            else return; // an older image given up late, or a repeat: nothing skipped, `last` stays
         }
         slot.lastFrameId = id;
+    }
+
+    static uint64_t incompleteImages(const Slot &slot) {
+        uint64_t n = 0;
+        for (const auto &[name, count] : slot.failures) n += count;
+        return n;
+    }
+
+    // Ids skipped between complete images, less the incomplete images among them.
+    static uint64_t skippedIds(const Slot &slot) {
+        const uint64_t incomplete = incompleteImages(slot);
+        return slot.idGap > incomplete ? slot.idGap - incomplete : 0;
     }
 
     void dropPending(Slot &slot, bool countUnpaired) {
@@ -594,7 +606,6 @@ private:
             Camera &camera = *slot.camera;
             while (ArvBuffer *buffer = camera.tryPop()) {
                 const ArvBufferStatus status = arv_buffer_get_status(buffer);
-                countSkippedIds(slot, arv_buffer_get_frame_id(buffer));
                 if (trigger_ == "software") {
                     // Exactly one image per camera answers a trigger: anything more is stale.
                     if (slot.answered) {
@@ -607,6 +618,7 @@ private:
                 } else if (trigger_ == "free_run") {
                     slot.awaitingSince = now;
                 }
+                if (status == ARV_BUFFER_STATUS_SUCCESS) countIdGap(slot, arv_buffer_get_frame_id(buffer));
                 if (status != ARV_BUFFER_STATUS_SUCCESS) {
                     ++slot.failures[statusName(status)];
                     camera.home()->push(buffer);
