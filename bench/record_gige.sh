@@ -7,7 +7,7 @@
 #   before: the transport and writer of before issue 10 (kernel-default 208 KiB socket
 #           buffer, 8 stream buffers, one writer thread that the grab waits for)
 #   now:    the shipped rig's defaults (configs/rigs/gige-two-cameras.yaml)
-# Each run stops after PAIRS pairs or its time (30 s before, 150 s now; Ctrl-C: a clean stop)
+# Each run stops after PAIRS pairs or its time (30 s before, 150 s now; one SIGINT: a clean stop)
 # and prints, per run, pairs written per second and per image the cameras sent, every loss
 # by place, and the ratios now / before.
 #
@@ -41,7 +41,7 @@ record() { # NAME SECONDS EXTRA-ARGS...: at most SECONDS, then Ctrl-C (a clean s
     name=$1
     seconds=$2
     shift 2
-    timeout -s INT "$seconds" "$binocle" record "$here/configs/rigs/gige-two-cameras.yaml" --out "$work/$name" --frames "$pairs" --quiet \
+    timeout --foreground -s INT "$seconds" "$binocle" record "$here/configs/rigs/gige-two-cameras.yaml" --out "$work/$name" --frames "$pairs" --quiet \
         --set source.camera_left=127.0.0.2 --set source.camera_right=127.0.0.3 \
         --set source.width=640 --set source.height=480 --set source.trigger=free_run \
         --set source.frame_rate_hz="$rate" "$@" >"$work/$name.log" 2>&1 || true
@@ -58,7 +58,8 @@ for name in ("before", "now"):
     try:
         s = json.load(open(f"{work}/{name}/summary.json"))
     except OSError:
-        print(f"{name}: no summary; log:\n" + open(f"{work}/{name}.log").read())
+        import os
+        print(f"{name}: no summary ({os.listdir(work)}); log:\n" + open(f"{work}/{name}.log").read())
         continue
     runs[name] = s
     lost = s["lost"]
