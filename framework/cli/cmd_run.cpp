@@ -4,6 +4,7 @@
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/stop_signal.hpp"
 
 #include <iostream>
 
@@ -20,13 +21,16 @@ int run(const Args &args) {
     options.out_dir = args.get("--out", "");
     options.progress = !args.has("--quiet");
     Pipeline pipeline(rig, host);
-    Json summary = pipeline.run(options);
-    const Json *count = summary.get("frame_count");
-    std::cerr << "binocle run: " << (count ? count->number() : 0) << " frame(s) of rig '" << rig.name << "'";
+    StopSignalGuard signals; // Ctrl-C / SIGTERM: finish the frames in flight, write the summary
+    options.stop = &StopSignalGuard::requested();
+    const nlohmann::ordered_json summary = pipeline.run(options);
+    std::cerr << "binocle run: " << summary.value("frame_count", int64_t{0}) << " frame(s) of rig '" << rig.name << "'";
+    if (summary.value("status", "") == "interrupted") std::cerr << " (interrupted)";
     if (!options.out_dir.empty()) std::cerr << " written to " << options.out_dir << " (summary.json)";
     std::cerr << "\n";
-    if (options.out_dir.empty()) std::cout << summary.dump();
-    return 0;
+    if (options.out_dir.empty()) std::cout << summary.dump(2) << "\n";
+    // Interrupted: the usual 128 + signal, though everything finished was written.
+    return summary.value("status", "") == "interrupted" ? 128 + StopSignalGuard::signalNumber() : 0;
 }
 
 Register reg({"run", "run a rig: disparity, cloud in ground coordinates, evaluators",
@@ -36,8 +40,10 @@ Register reg({"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "  disparity_NNNNNN.png        16-bit disparity, KITTI convention (d * 256, 0 = invalid)\n"
               "  disparity_color_NNNNNN.png  colourised disparity (invalid = black)\n"
               "  cloud_NNNNNN.ply            binary PLY, millimetres, frame stated in the header\n"
-              "and summary.json (per-frame figures, evaluator metrics, status). Without --out\n"
-              "the summary goes to standard output.\n\n"
+              "and frames.jsonl (one line of figures per frame, written as it finishes) and\n"
+              "summary.json (evaluator metrics, drops, status). Without --out the summary goes\n"
+              "to standard output. SIGINT/SIGTERM stop the run cleanly (status interrupted);\n"
+              "a second signal ends it at once. The rig's runtime: block sets the policy.\n\n"
               "  --frames N          stop after N frames (default: until the source ends)\n"
               "  --out DIR           output folder (created if needed)\n"
               "  --set KEY=VALUE     override any value of the rig, e.g.\n"

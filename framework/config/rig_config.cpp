@@ -272,9 +272,69 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
 }
 
 const std::vector<std::string> kTopKeys = {"name", "description", "source", "calibration", "matcher",
-                                           "transforms", "evaluators", "outputs"};
+                                           "transforms", "evaluators", "outputs", "runtime"};
 const std::vector<std::string> kOutputKeys = {"disparity_png", "disparity_color", "disparity_pfm", "cloud_ply",
                                               "rectified_png", "max_range_mm"};
+
+const std::vector<std::string> kRuntimeKeys = {"policy", "queue_depth", "matcher_instances", "on_source_error",
+                                               "retry_for_s"};
+
+RuntimeOptions runtimeBlock(const YAML::Node &r, const Context &ctx) {
+    RuntimeOptions rt;
+    if (!r.IsDefined() || r.IsNull()) return rt;
+    if (!r.IsMap()) ctx.fail(r, "runtime", "expected a map (policy: lossless, queue_depth: 4, ...)");
+    for (const auto &kv : r) {
+        const std::string key = kv.first.as<std::string>();
+        if (std::find(kRuntimeKeys.begin(), kRuntimeKeys.end(), key) != kRuntimeKeys.end()) continue;
+        std::string hint = nearest(key, kRuntimeKeys);
+        throw Error(ctx.at(kv.first, "runtime." + key).str() + ": runtime: unknown key '" + key + "'" +
+                    (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                    " (valid keys: policy, queue_depth, matcher_instances, on_source_error, retry_for_s)");
+    }
+    auto choice = [&](const char *key, const std::vector<std::string> &choices) -> std::optional<std::string> {
+        YAML::Node n = r[key];
+        if (!n || n.IsNull()) return std::nullopt;
+        if (n.IsScalar() && std::find(choices.begin(), choices.end(), n.Scalar()) != choices.end()) return n.Scalar();
+        std::string all, hint = n.IsScalar() ? nearest(n.Scalar(), choices) : "";
+        for (const auto &c : choices) all += (all.empty() ? "" : ", ") + c;
+        ctx.fail(n, std::string("runtime.") + key, "value '" + scalarText(n) + "' is not valid: expected one of " + all +
+                                                      (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+    };
+    auto integer = [&](const char *key, int &out, int lo, int hi) {
+        YAML::Node n = r[key];
+        if (!n || n.IsNull()) return;
+        long long v = 0;
+        bool ok = n.IsScalar();
+        if (ok) {
+            try {
+                size_t used = 0;
+                v = std::stoll(n.Scalar(), &used, 10);
+                ok = used == n.Scalar().size();
+            } catch (const std::logic_error &) {
+                ok = false;
+            }
+        }
+        if (!ok || v < lo || v > hi)
+            ctx.fail(n, std::string("runtime.") + key, "value '" + scalarText(n) + "' is not valid: expected an integer >= " +
+                                                          std::to_string(lo) + " <= " + std::to_string(hi));
+        out = static_cast<int>(v);
+    };
+    if (auto p = choice("policy", {"lossless", "latest"}))
+        rt.policy = *p == "latest" ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
+    integer("queue_depth", rt.queue_depth, 1, 1024);
+    integer("matcher_instances", rt.matcher_instances, 1, 64);
+    if (auto e = choice("on_source_error", {"stop", "retry"}))
+        rt.on_source_error = *e == "retry" ? RuntimeOptions::OnSourceError::Retry : RuntimeOptions::OnSourceError::Stop;
+    if (YAML::Node n = r["retry_for_s"]; n && !n.IsNull()) {
+        double v = 0;
+        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v) || !(v > 0))
+            ctx.fail(n, "runtime.retry_for_s", "value '" + scalarText(n) + "' is not valid: expected a positive number of seconds");
+        if (rt.on_source_error != RuntimeOptions::OnSourceError::Retry)
+            ctx.fail(n, "runtime.retry_for_s", "is only used with on_source_error: retry (on_source_error is stop)");
+        rt.retry_for_s = v;
+    }
+    return rt;
+}
 
 PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind, const PluginHost &host,
                   const Context &ctx) {
@@ -322,7 +382,7 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
         std::string hint = nearest(key, kTopKeys);
         throw Error(ctx.at(kv.first, key).str() + ": unknown key '" + key + "'" +
                     (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                    " (valid keys: name, description, source, calibration, matcher, transforms, evaluators, outputs)");
+                    " (valid keys: name, description, source, calibration, matcher, transforms, evaluators, outputs, runtime)");
     }
     RigConfig rig;
     rig.file = ctx.file;
@@ -368,6 +428,7 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
             rig.outputs.max_range_mm = v;
         }
     }
+    rig.runtime = runtimeBlock(root["runtime"], ctx);
     YAML::Emitter e;
     e << root;
     rig.resolved_yaml = e.c_str();

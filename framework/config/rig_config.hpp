@@ -40,6 +40,18 @@ struct OutputOptions {
     double max_range_mm = 50000; // points farther are dropped from the cloud
 };
 
+// The rig's `runtime:` block: how the stage pipeline runs (README "Runtime").
+struct RuntimeOptions {
+    enum class Policy { Lossless, Latest };
+    // Unset: the source decides (`latest` for a live source, `lossless` otherwise).
+    std::optional<Policy> policy;
+    int queue_depth = 4;           // frames waiting between two stages
+    int matcher_instances = 1;     // parallel matcher instances, each on its own thread
+    enum class OnSourceError { Stop, Retry };
+    OnSourceError on_source_error = OnSourceError::Stop;
+    double retry_for_s = 30;       // with retry: how long the source may stay in error
+};
+
 struct RigConfig {
     std::string file;     // absolute path of the YAML
     std::string base_dir; // its folder: relative paths resolve against it
@@ -50,6 +62,7 @@ struct RigConfig {
     std::vector<PluginBlock> transforms;
     std::vector<PluginBlock> evaluators;
     OutputOptions outputs;
+    RuntimeOptions runtime;
     std::string resolved_yaml; // the rig after --set overrides
 };
 

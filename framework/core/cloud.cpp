@@ -34,11 +34,13 @@ void Cloud::adopt(const binocle_cloud &view) {
 
 Cloud cloudFromDisparity(const cv::Mat &disparity, const StereoCalibration &cal, const cv::Mat &left,
                          double max_range_mm) {
-    CV_Assert(disparity.type() == CV_32F);
     Cloud cloud;
-    cloud.image_width = disparity.cols;
-    cloud.image_height = disparity.rows;
-    const bool color = !left.empty() && left.size() == disparity.size();
+    CloudProjector(cal, max_range_mm).project(disparity, left, cloud);
+    return cloud;
+}
+
+CloudProjector::CloudProjector(const StereoCalibration &cal, double max_range_mm)
+    : maxRange_(max_range_mm) {
     if (cal.Q.empty()) throw Error("cloud: the calibration has no Q matrix (rectification not computed)");
     cv::Mat q64, r64;
     cal.Q.convertTo(q64, CV_64F);
@@ -48,35 +50,78 @@ Cloud cloudFromDisparity(const cv::Mat &disparity, const StereoCalibration &cal,
         cal.R1.convertTo(r64, CV_64F);
         R1t = cv::Matx33d(r64.reshape(1, 1).ptr<double>()).t();
     }
-    const size_t reserve = static_cast<size_t>(cv::countNonZero(disparity > 0));
-    cloud.xyz.reserve(3 * reserve);
-    cloud.pixel.reserve(reserve);
-    if (color) cloud.rgb.reserve(3 * reserve);
-    for (int v = 0; v < disparity.rows; ++v) {
-        const float *d = disparity.ptr<float>(v);
-        for (int u = 0; u < disparity.cols; ++u) {
-            if (!(d[u] > 0)) continue;
-            const cv::Vec4d h = Q * cv::Vec4d(u, v, d[u], 1.0);
-            if (!(h[3] > 0)) continue;
-            const cv::Vec3d pr(h[0] / h[3], h[1] / h[3], h[2] / h[3]);
-            if (!(pr[2] > 0) || pr[2] > max_range_mm) continue;
-            const cv::Vec3d p = R1t * pr;
-            cloud.xyz.push_back(static_cast<float>(p[0]));
-            cloud.xyz.push_back(static_cast<float>(p[1]));
-            cloud.xyz.push_back(static_cast<float>(p[2]));
-            cloud.pixel.push_back(v * disparity.cols + u);
-            if (color) {
-                if (left.channels() == 3) {
-                    const cv::Vec3b &bgr = left.at<cv::Vec3b>(v, u);
-                    cloud.rgb.insert(cloud.rgb.end(), {bgr[2], bgr[1], bgr[0]});
-                } else {
-                    const uint8_t g = left.at<uint8_t>(v, u);
-                    cloud.rgb.insert(cloud.rgb.end(), {g, g, g});
-                }
-            }
+    // h = Q (u, v, d, 1): column k of Q multiplies the k-th input; the rotated
+    // numerators are R1^T times the first three rows.
+    for (int k = 0; k < 4; ++k) {
+        const cv::Vec3d q(Q(0, k), Q(1, k), Q(2, k));
+        const cv::Vec3d rotated = R1t * q;
+        const double five[5] = {rotated[0], rotated[1], rotated[2], Q(2, k), Q(3, k)};
+        for (int i = 0; i < 5; ++i) {
+            double &slot = k == 0 ? col_[i] : k == 1 ? rowV_[i] : k == 2 ? disp_[i] : row1_[i];
+            slot = five[i];
         }
     }
-    return cloud;
+}
+
+size_t CloudProjector::project(const cv::Mat &disparity, const cv::Mat &left, Cloud &cloud) const {
+    CV_Assert(disparity.type() == CV_32F);
+    const int rows = disparity.rows, cols = disparity.cols;
+    const bool color = !left.empty() && left.size() == disparity.size();
+    const bool bgr = color && left.channels() == 3;
+    cloud.image_width = cols;
+    cloud.image_height = rows;
+    cloud.frame = BINOCLE_FRAME_CAMERA;
+    // Size the arrays to the valid pixels: a cheap pass that the compiler vectorises,
+    // so that growing the arrays never fills more than the new points.
+    size_t valid = 0;
+    for (int v = 0; v < rows; ++v) {
+        const float *d = disparity.ptr<float>(v);
+        int n = 0;
+        for (int u = 0; u < cols; ++u) n += d[u] > 0.f;
+        valid += static_cast<size_t>(n);
+    }
+    cloud.xyz.resize(3 * valid);
+    cloud.pixel.resize(valid);
+    if (color) cloud.rgb.resize(3 * valid);
+    else cloud.rgb.clear();
+    float *xyz = cloud.xyz.data();
+    int32_t *pixel = cloud.pixel.data();
+    uint8_t *rgb = color ? cloud.rgb.data() : nullptr;
+    size_t n = 0;
+    for (int v = 0; v < rows; ++v) {
+        const float *d = disparity.ptr<float>(v);
+        const uint8_t *px = color ? left.ptr<uint8_t>(v) : nullptr;
+        double r[5];
+        for (int i = 0; i < 5; ++i) r[i] = rowV_[i] * v + row1_[i];
+        const int32_t rowStart = v * cols;
+        for (int u = 0; u < cols; ++u) {
+            if (!(d[u] > 0.f)) continue;
+            const double dv = d[u], du = u;
+            const double w = r[4] + du * col_[4] + dv * disp_[4];
+            if (!(w > 0)) continue;
+            const double inv = 1 / w;
+            const double zr = (r[3] + du * col_[3] + dv * disp_[3]) * inv;
+            if (!(zr > 0) || zr > maxRange_) continue;
+            xyz[3 * n] = static_cast<float>((r[0] + du * col_[0] + dv * disp_[0]) * inv);
+            xyz[3 * n + 1] = static_cast<float>((r[1] + du * col_[1] + dv * disp_[1]) * inv);
+            xyz[3 * n + 2] = static_cast<float>((r[2] + du * col_[2] + dv * disp_[2]) * inv);
+            pixel[n] = rowStart + u;
+            if (rgb) {
+                if (bgr) {
+                    rgb[3 * n] = px[3 * u + 2];
+                    rgb[3 * n + 1] = px[3 * u + 1];
+                    rgb[3 * n + 2] = px[3 * u];
+                } else {
+                    rgb[3 * n] = rgb[3 * n + 1] = rgb[3 * n + 2] = px[u];
+                }
+            }
+            ++n;
+        }
+    }
+    cloud.xyz.resize(3 * n);
+    cloud.pixel.resize(n);
+    if (color) cloud.rgb.resize(3 * n);
+    return valid;
 }
 
 void writePly(const std::string &path, const Cloud &cloud) {

@@ -35,6 +35,27 @@ public:
 Cloud cloudFromDisparity(const cv::Mat &disparity, const StereoCalibration &calibration, const cv::Mat &left,
                          double max_range_mm);
 
+// The cloud stage of the runtime: the same points as cloudFromDisparity, computed
+// straight from the disparity without an XYZ image. Q and R1^T are folded into
+// per-column and per-disparity coefficients once, the row terms once per row, and only
+// pixels with a valid disparity are visited; `out` keeps its storage from frame to frame.
+class CloudProjector {
+public:
+    CloudProjector() = default;
+    CloudProjector(const StereoCalibration &calibration, double max_range_mm);
+    // Fills `out` (reusing its arrays) and returns the number of pixels with a disparity
+    // > 0. `left` (GRAY8 or BGR8, may be empty) gives the colours.
+    size_t project(const cv::Mat &disparity, const cv::Mat &left, Cloud &out) const;
+
+private:
+    // Five quantities per pixel: the three numerators of R1^T * (X, Y, Z), the
+    // rectified Z numerator (for the range test) and W; each = row + u * col + d * disp.
+    // Double precision: the terms cancel (u - cx), and the points must match the former
+    // triangulation to float rounding.
+    double col_[5] = {}, disp_[5] = {}, rowV_[5] = {}, row1_[5] = {};
+    double maxRange_ = 0;
+};
+
 // Binary little-endian PLY with x, y, z (float, mm) and red, green, blue when present.
 // The header's comments state the units and the frame. Written atomically.
 void writePly(const std::string &path, const Cloud &cloud);

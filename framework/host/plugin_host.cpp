@@ -618,9 +618,16 @@ Matcher::~Matcher() {
 }
 
 cv::Mat Matcher::compute(const cv::Mat &left, const cv::Mat &right) {
+    cv::Mat disparity;
+    compute(left, right, disparity);
+    return disparity;
+}
+
+void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) {
     if (left.size() != right.size() || left.type() != right.type())
         throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
-    cv::Mat disparity(left.size(), CV_32F, cv::Scalar(BINOCLE_INVALID_DISPARITY));
+    disparity.create(left.size(), CV_32F);
+    disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
     binocle_image l = wrap(left, formatOf(left)), r = wrap(right, formatOf(right));
     binocle_image d = wrap(disparity, BINOCLE_PIXEL_FLOAT32);
     const binocle_image expected = d;
@@ -629,7 +636,6 @@ cv::Mat Matcher::compute(const cv::Mat &left, const cv::Mat &right) {
     if (d.data != expected.data || d.width != expected.width || d.height != expected.height || d.format != expected.format ||
         d.stride_bytes != expected.stride_bytes)
         fail("compute", BINOCLE_ERR_INTERNAL, "changed the host's disparity image description instead of writing into it");
-    return disparity;
 }
 
 std::pair<int32_t, int32_t> Matcher::disparityRange() {

@@ -129,6 +129,8 @@ public:
     ~Matcher();
     // Returns a CV_32F disparity (host-allocated), invalid pixels <= 0.
     cv::Mat compute(const cv::Mat &left, const cv::Mat &right);
+    // The same into `disparity`, whose buffer is reused when it has the size already.
+    void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity);
     std::pair<int32_t, int32_t> disparityRange();
 
 private:

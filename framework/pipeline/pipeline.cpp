@@ -1,27 +1,220 @@
 // SPDX-License-Identifier: MIT
-// The pipeline: acquire, rectify, match, triangulate, transform, evaluate, write.
+// The pipeline as stages on their own threads: acquire | rectify + match (one or more
+// matcher instances) | cloud + transforms | evaluators | writer (the calling thread).
+// Frames travel in pooled jobs whose buffers are reused; bounded queues join the stages
+// and the ordered ones restore frame order behind parallel matchers.
 #include "pipeline/pipeline.hpp"
 
 #include "calibration/geometry_check.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
+#include "pipeline/stage_queue.hpp"
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+#include <thread>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 namespace fs = std::filesystem;
 
 namespace binocle {
 
+using Clock = std::chrono::steady_clock;
+using OrderedJson = nlohmann::ordered_json;
+
+namespace {
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Whether the source says its frames come on their own clock (cameras): the
+// `live: true` entry of its statistics (sdk/include/binocle/abi/source.h).
+bool sourceIsLive(const std::string &statistics) {
+    if (statistics.empty()) return false;
+    try {
+        const YAML::Node n = YAML::Load(statistics);
+        return n.IsMap() && n["live"] && n["live"].as<bool>(false);
+    } catch (const YAML::Exception &) {
+        return false;
+    }
+}
+
+// Frames a source lost before it could deliver them, from the counters of its
+// statistics that source.h names: `unpaired` at the top level (pairing), and
+// `failed_buffers`, `underrun_buffers`, `corrupt`, `dropped_by_driver` anywhere
+// (camera or transport), each named by where it sits ("cameras.left.failed_buffers").
+void sourceDrops(const YAML::Node &node, const std::string &path, OrderedJson &camera) {
+    static const char *kCameraKeys[] = {"failed_buffers", "underrun_buffers", "corrupt", "dropped_by_driver"};
+    if (node.IsMap()) {
+        for (const auto &kv : node) {
+            const std::string key = kv.first.as<std::string>("");
+            const std::string where = path.empty() ? key : path + "." + key;
+            bool counted = false;
+            for (const char *k : kCameraKeys)
+                if (key == k && kv.second.IsScalar()) {
+                    camera[where] = kv.second.as<int64_t>(0);
+                    counted = true;
+                }
+            if (!counted) sourceDrops(kv.second, where, camera);
+        }
+    } else if (node.IsSequence()) {
+        for (size_t i = 0; i < node.size(); ++i) {
+            std::string name = std::to_string(i);
+            if (node[i].IsMap() && node[i]["role"] && node[i]["role"].IsScalar()) name = node[i]["role"].Scalar();
+            sourceDrops(node[i], path + "." + name, camera);
+        }
+    }
+}
+
+class Progress {
+public:
+    explicit Progress(bool enabled, int64_t total) : enabled_(enabled), total_(total), tty_(::isatty(2) != 0) {}
+    void update(int64_t done, double fps) {
+        if (!enabled_) return;
+        const auto now = Clock::now();
+        if (!tty_ && done > 1 && now - last_ < std::chrono::seconds(2)) return;
+        last_ = now;
+        char buf[128];
+        if (total_ > 0)
+            std::snprintf(buf, sizeof buf, "frame %lld/%lld  %.1f fps", static_cast<long long>(done), static_cast<long long>(total_), fps);
+        else
+            std::snprintf(buf, sizeof buf, "frame %lld  %.1f fps", static_cast<long long>(done), fps);
+        std::cerr << (tty_ ? "\r" : "") << buf << (tty_ ? "" : "\n") << std::flush;
+        printed_ = true;
+    }
+    ~Progress() {
+        if (printed_ && tty_) std::cerr << "\n";
+    }
+
+private:
+    bool enabled_;
+    int64_t total_;
+    bool tty_;
+    bool printed_ = false;
+    Clock::time_point last_{};
+};
+
+// One line per frame, flushed as it is written: a killed run keeps every finished frame.
+class FramesFile {
+public:
+    explicit FramesFile(const std::string &path) {
+        if (path.empty()) return;
+        file_ = std::fopen(path.c_str(), "w");
+        if (!file_) throw Error(path + ": cannot write: " + std::strerror(errno));
+        path_ = path;
+    }
+    ~FramesFile() {
+        if (file_) std::fclose(file_);
+    }
+    void write(const OrderedJson &line) {
+        if (!file_) return;
+        const std::string text = line.dump() + "\n";
+        if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0)
+            throw Error(path_ + ": cannot write: " + std::strerror(errno));
+    }
+
+private:
+    std::FILE *file_ = nullptr;
+    std::string path_;
+};
+
+} // namespace
+
+// ---- LatestFrame -------------------------------------------------------------------------------
+
+void LatestFrame::onFrame(const FrameResult &r) {
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || slot_) {
+        ++skipped_;
+        return;
+    }
+    FrameSnapshot s;
+    s.index = r.index;
+    s.sequence = r.sequence;
+    r.rectified_left.copyTo(s.rectified_left);
+    r.disparity.copyTo(s.disparity);
+    s.cloud = r.cloud;
+    s.metrics = r.metrics;
+    slot_ = std::move(s);
+}
+
+std::optional<FrameSnapshot> LatestFrame::take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::optional<FrameSnapshot> s = std::move(slot_);
+    slot_.reset();
+    return s;
+}
+
+// ---- Pipeline ----------------------------------------------------------------------------------
+
+// A frame on its way through the stages; its buffers are reused by later frames.
+struct Pipeline::Job {
+    std::unique_ptr<LentFrame> frame;
+    Clock::time_point grabbed;
+    FrameResult r;
+    bool failed = false;
+};
+
+struct Pipeline::RunState {
+    struct Grabbed {
+        std::unique_ptr<LentFrame> frame;
+        Clock::time_point at;
+    };
+    RunState(const RunOptions &o, size_t sourceDepth, size_t stageDepth)
+        : options(o), sourceQueue(sourceDepth), matched(stageDepth), clouded(stageDepth), evaluated(stageDepth) {}
+
+    const RunOptions &options;
+    RuntimeOptions::Policy policy = RuntimeOptions::Policy::Lossless;
+    SourceQueue<Grabbed> sourceQueue;
+    OrderedQueue<std::unique_ptr<Job>> matched, clouded, evaluated;
+
+    std::mutex poolMutex;
+    std::condition_variable poolReady;
+    std::vector<std::unique_ptr<Job>> pool;
+
+    std::atomic<bool> aborted{false};
+    std::mutex failMutex;
+    std::string failure;
+
+    // Written by the acquire stage, read after it is joined.
+    int64_t grabbed = 0, droppedByPolicy = 0, sourceErrors = 0, recoveries = 0;
+    bool endOfStream = false;
+    std::string lastSourceError;
+
+    bool stopRequested() const { return options.stop && options.stop->load(); }
+    // A failed stage ends the run: frames behind it are not finished. A failed source
+    // (`processing` false) only ends acquisition: the frames it delivered are.
+    void fail(const std::string &what, bool processing = true) {
+        std::lock_guard<std::mutex> lock(failMutex);
+        if (failure.empty()) failure = what;
+        if (processing) aborted = true;
+    }
+    std::unique_ptr<Job> takeJob() {
+        std::unique_lock<std::mutex> lock(poolMutex);
+        poolReady.wait(lock, [&] { return !pool.empty(); });
+        std::unique_ptr<Job> job = std::move(pool.back());
+        pool.pop_back();
+        return job;
+    }
+    void giveJob(std::unique_ptr<Job> job) {
+        std::lock_guard<std::mutex> lock(poolMutex);
+        pool.push_back(std::move(job));
+        poolReady.notify_one();
+    }
+};
+
 Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
     source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
-    matcher_ = std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params);
+    for (int i = 0; i < rig.runtime.matcher_instances; ++i)
+        matchers_.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
     for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
     for (const auto &e : rig.evaluators) {
         auto slot = std::make_unique<EvaluatorSlot>();
@@ -31,11 +224,11 @@ Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
         sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
             if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
             if (!raw->target) return;
-            raw->target->set(name, value);
-            if (!unit.empty()) raw->target->set(name + "_unit", unit);
+            (*raw->target)[name] = value;
+            if (!unit.empty()) (*raw->target)[name + "_unit"] = unit;
         };
         sink.text = [raw](const std::string &name, const std::string &text) {
-            if (raw->target) raw->target->set(name, text);
+            if (raw->target) (*raw->target)[name] = text;
         };
         slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
         evaluators_.push_back(std::move(slot));
@@ -71,72 +264,202 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
         cv::initUndistortRectifyMap(calibration_.M2, calibration_.D2, calibration_.R2, calibration_.P2, imageSize, CV_32FC1,
                                     map2x_, map2y_);
     }
+    projector_ = CloudProjector(calibration_, rig_.outputs.max_range_mm);
     calibrationReady_ = true;
 }
 
-FrameResult Pipeline::process(const LentFrame &frame) {
-    const auto t0 = std::chrono::steady_clock::now();
-    FrameResult r;
-    r.sequence = frame.raw().sequence;
-    cv::Mat left = frame.left(), right = frame.right();
-    if (!calibrationReady_) prepareCalibration(left.size());
-    if (calibration_.rectified) {
-        r.rectified_left = left; // zero-copy: the frame stays lent until we return
-        r.rectified_right = right;
-    } else {
-        cv::remap(left, r.rectified_left, map1x_, map1y_, cv::INTER_LINEAR);
-        cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
-    }
-    r.disparity = matcher_->compute(r.rectified_left, r.rectified_right);
-    r.valid_pixel_ratio = static_cast<double>(cv::countNonZero(r.disparity > 0)) / static_cast<double>(r.disparity.total());
-    r.cloud = cloudFromDisparity(r.disparity, calibration_, r.rectified_left, rig_.outputs.max_range_mm);
-    for (auto &t : transforms_) {
-        binocle_cloud view = r.cloud.view();
-        t->apply(view);
-        r.cloud.adopt(view);
-    }
-    r.metrics = Json::object();
-    if (!evaluators_.empty()) {
-        binocle_image rl{}, rr{}, d{};
-        auto wrap = [](const cv::Mat &m, binocle_image &im) {
-            im.width = m.cols;
-            im.height = m.rows;
-            im.stride_bytes = static_cast<int32_t>(m.step[0]);
-            im.format = m.type() == CV_32F ? BINOCLE_PIXEL_FLOAT32 : m.channels() == 3 ? BINOCLE_PIXEL_BGR8 : BINOCLE_PIXEL_GRAY8;
-            im.data = m.data;
-        };
-        wrap(r.rectified_left, rl);
-        wrap(r.rectified_right, rr);
-        wrap(r.disparity, d);
-        binocle_cloud cloud = r.cloud.view();
-        binocle_eval_input in{};
-        in.struct_size = sizeof(in);
-        in.frame = &frame.raw();
-        in.rectified_left = &rl;
-        in.rectified_right = &rr;
-        in.disparity = &d;
-        in.cloud = &cloud;
-        in.calibration_yaml = calibrationYaml_.c_str();
-        in.rig_yaml = rig_.resolved_yaml.c_str();
-        in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
-        for (auto &slot : evaluators_) {
-            Json figures = Json::object();
-            slot->target = &figures;
-            slot->flat = &r.figures;
+// Stage 1: grabs pairs and queues them by the policy. A grab waits in short slices so
+// that a stop request is seen within a fraction of a second even from a silent camera.
+void Pipeline::acquire(RunState &s) {
+    const RuntimeOptions &rt = rig_.runtime;
+    const bool retry = rt.on_source_error == RuntimeOptions::OnSourceError::Retry;
+    std::optional<Clock::time_point> outage;
+    auto pause = [&](std::chrono::milliseconds d) {
+        const auto until = Clock::now() + d;
+        while (Clock::now() < until && !s.stopRequested() && !s.aborted)
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    };
+    try {
+        source_->start();
+        while (!s.stopRequested() && !s.aborted) {
+            if (s.options.max_frames >= 0 && s.grabbed >= s.options.max_frames) break;
+            std::unique_ptr<LentFrame> frame;
             try {
-                slot->evaluator->evaluate(in);
-            } catch (...) {
-                slot->target = nullptr;
-                slot->flat = nullptr;
-                throw;
+                const auto t0 = Clock::now();
+                const int32_t total = s.options.grab_timeout_ms;
+                for (;;) {
+                    const int32_t left = total < 0 ? 250 : std::max<int32_t>(1, total - static_cast<int32_t>(secondsSince(t0) * 1000));
+                    try {
+                        frame = source_->grab(std::min<int32_t>(250, left));
+                        break;
+                    } catch (const PluginError &e) {
+                        if (e.code() != BINOCLE_ERR_TIMEOUT || s.stopRequested() || s.aborted) throw;
+                        if (total >= 0 && secondsSince(t0) * 1000 >= total) throw;
+                    }
+                }
+            } catch (const PluginError &e) {
+                if (s.stopRequested() && e.code() == BINOCLE_ERR_TIMEOUT) break;
+                if (!retry || (e.code() != BINOCLE_ERR_DEVICE && e.code() != BINOCLE_ERR_TIMEOUT)) throw;
+                if (!outage) {
+                    outage = Clock::now();
+                    ++s.sourceErrors;
+                    s.lastSourceError = e.what();
+                    spdlog::warn("source error, retrying for up to {} s: {}", rt.retry_for_s, e.what());
+                }
+                if (secondsSince(*outage) > rt.retry_for_s)
+                    throw Error(std::string(e.what()) + " (still failing after retry_for_s: " + std::to_string(rt.retry_for_s) + " s)");
+                pause(std::chrono::milliseconds(100));
+                continue;
             }
-            slot->target = nullptr;
-            slot->flat = nullptr;
-            r.metrics.set(slot->name, std::move(figures));
+            if (outage) {
+                ++s.recoveries;
+                spdlog::info("source recovered after {:.1f} s", secondsSince(*outage));
+                outage.reset();
+            }
+            if (!frame) {
+                s.endOfStream = true;
+                break;
+            }
+            if (!calibrationReady_) prepareCalibration(frame->left().size());
+            ++s.grabbed;
+            RunState::Grabbed g{std::move(frame), Clock::now()};
+            if (s.policy == RuntimeOptions::Policy::Latest) {
+                if (s.sourceQueue.pushDropOldest(std::move(g))) ++s.droppedByPolicy; // released here
+            } else if (!s.sourceQueue.pushWait(g)) {
+                break;
+            }
         }
+    } catch (const std::exception &e) {
+        s.fail(e.what(), false);
     }
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
+    s.sourceQueue.close();
+}
+
+// Stage 2 (one thread per matcher instance): rectify into pooled images, then match.
+void Pipeline::rectifyAndMatch(RunState &s, Matcher &matcher) {
+    for (;;) {
+        std::unique_ptr<Job> job = s.takeJob();
+        uint64_t ordinal = 0;
+        std::optional<RunState::Grabbed> g = s.sourceQueue.pop(ordinal);
+        if (!g) {
+            s.giveJob(std::move(job));
+            break;
+        }
+        FrameResult &r = job->r;
+        job->frame = std::move(g->frame);
+        job->grabbed = g->at;
+        job->failed = s.aborted;
+        r.index = ordinal;
+        r.sequence = job->frame->raw().sequence;
+        r.frame = job->frame.get();
+        r.seconds = 0;
+        if (!job->failed) {
+            try {
+                const auto t0 = Clock::now();
+                const cv::Mat left = job->frame->left(), right = job->frame->right();
+                if (calibration_.rectified) {
+                    r.rectified_left = left; // zero-copy: the frame stays lent until the writer is done
+                    r.rectified_right = right;
+                } else {
+                    cv::remap(left, r.rectified_left, map1x_, map1y_, cv::INTER_LINEAR);
+                    cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
+                }
+                matcher.compute(r.rectified_left, r.rectified_right, r.disparity);
+                r.seconds += secondsSince(t0);
+            } catch (const std::exception &e) {
+                s.fail(e.what());
+                job->failed = true;
+            }
+        }
+        s.matched.push(ordinal, std::move(job));
+    }
+    s.matched.producerDone();
+}
+
+// Stage 3: cloud in camera coordinates (pooled arrays), then the transforms.
+void Pipeline::cloudAndTransforms(RunState &s) {
+    while (std::optional<std::unique_ptr<Job>> job = s.matched.pop()) {
+        FrameResult &r = (*job)->r;
+        if (!(*job)->failed && !s.aborted) {
+            try {
+                const auto t0 = Clock::now();
+                const size_t valid = projector_.project(r.disparity, r.rectified_left, r.cloud);
+                r.valid_pixel_ratio = static_cast<double>(valid) / static_cast<double>(r.disparity.total());
+                for (auto &t : transforms_) {
+                    binocle_cloud view = r.cloud.view();
+                    t->apply(view);
+                    r.cloud.adopt(view);
+                }
+                r.seconds += secondsSince(t0);
+            } catch (const std::exception &e) {
+                s.fail(e.what());
+                (*job)->failed = true;
+            }
+        } else {
+            (*job)->failed = true;
+        }
+        const uint64_t index = r.index;
+        s.clouded.push(index, std::move(*job));
+    }
+    s.clouded.producerDone();
+}
+
+// Stage 4: the evaluators, in order, on one thread.
+void Pipeline::evaluate(RunState &s) {
+    while (std::optional<std::unique_ptr<Job>> job = s.clouded.pop()) {
+        FrameResult &r = (*job)->r;
+        r.metrics = OrderedJson::object();
+        r.figures.clear();
+        if (!(*job)->failed && !s.aborted && !evaluators_.empty()) {
+            try {
+                const auto t0 = Clock::now();
+                binocle_image rl{}, rr{}, d{};
+                auto wrap = [](const cv::Mat &m, binocle_image &im) {
+                    im.width = m.cols;
+                    im.height = m.rows;
+                    im.stride_bytes = static_cast<int32_t>(m.step[0]);
+                    im.format = m.type() == CV_32F ? BINOCLE_PIXEL_FLOAT32 : m.channels() == 3 ? BINOCLE_PIXEL_BGR8 : BINOCLE_PIXEL_GRAY8;
+                    im.data = m.data;
+                };
+                wrap(r.rectified_left, rl);
+                wrap(r.rectified_right, rr);
+                wrap(r.disparity, d);
+                binocle_cloud cloud = r.cloud.view();
+                binocle_eval_input in{};
+                in.struct_size = sizeof(in);
+                in.frame = &(*job)->frame->raw();
+                in.rectified_left = &rl;
+                in.rectified_right = &rr;
+                in.disparity = &d;
+                in.cloud = &cloud;
+                in.calibration_yaml = calibrationYaml_.c_str();
+                in.rig_yaml = rig_.resolved_yaml.c_str();
+                in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
+                for (auto &slot : evaluators_) {
+                    OrderedJson figures = OrderedJson::object();
+                    slot->target = &figures;
+                    slot->flat = &r.figures;
+                    try {
+                        slot->evaluator->evaluate(in);
+                    } catch (...) {
+                        slot->target = nullptr;
+                        slot->flat = nullptr;
+                        throw;
+                    }
+                    slot->target = nullptr;
+                    slot->flat = nullptr;
+                    r.metrics[slot->name] = std::move(figures);
+                }
+                r.seconds += secondsSince(t0);
+            } catch (const std::exception &e) {
+                s.fail(e.what());
+                (*job)->failed = true;
+            }
+        }
+        const uint64_t index = r.index;
+        s.evaluated.push(index, std::move(*job));
+    }
+    s.evaluated.producerDone();
 }
 
 void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const {
@@ -154,107 +477,159 @@ void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const 
     if (o.cloud_ply) writePly((d / ("cloud_" + std::string(stem) + ".ply")).string(), r.cloud);
 }
 
-namespace {
-
-class Progress {
-public:
-    explicit Progress(bool enabled, int64_t total) : enabled_(enabled), total_(total), tty_(::isatty(2) != 0) {}
-    void update(int64_t done, double fps) {
-        if (!enabled_) return;
-        const auto now = std::chrono::steady_clock::now();
-        if (!tty_ && done > 1 && now - last_ < std::chrono::seconds(2)) return;
-        last_ = now;
-        char buf[128];
-        if (total_ > 0)
-            std::snprintf(buf, sizeof buf, "frame %lld/%lld  %.1f fps", static_cast<long long>(done), static_cast<long long>(total_), fps);
-        else
-            std::snprintf(buf, sizeof buf, "frame %lld  %.1f fps", static_cast<long long>(done), fps);
-        std::cerr << (tty_ ? "\r" : "") << buf << (tty_ ? "" : "\n") << std::flush;
-        printed_ = true;
-    }
-    ~Progress() {
-        if (printed_ && tty_) std::cerr << "\n";
-    }
-
-private:
-    bool enabled_;
-    int64_t total_;
-    bool tty_;
-    bool printed_ = false;
-    std::chrono::steady_clock::time_point last_{};
-};
-
-} // namespace
-
-Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
+OrderedJson Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
     outDir_ = options.out_dir;
     if (!outDir_.empty()) {
         std::error_code ec;
         fs::create_directories(outDir_, ec);
         if (ec) throw Error("--out " + outDir_ + ": cannot create the folder: " + ec.message());
     }
-    Json summary = Json::object();
-    summary.set("rig", rig_.file);
-    summary.set("name", rig_.name);
-    summary.set("source", rig_.source.plugin);
-    summary.set("matcher", rig_.matcher.plugin);
-    summary.set("units", Json::object().set("length", "mm").set("disparity", "px").set("disparity_png_scale", 256));
-    Json frames = Json::array();
-    const auto start = std::chrono::steady_clock::now();
-    int64_t count = 0;
-    std::string failure;
-    auto writeSummary = [&]() {
-        summary.set("frames", frames);
-        if (outDir_.empty()) return;
-        writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump());
-    };
+    const RuntimeOptions &rt = rig_.runtime;
+    OrderedJson summary = OrderedJson::object();
+    summary["rig"] = rig_.file;
+    summary["name"] = rig_.name;
+    summary["source"] = rig_.source.plugin;
+    summary["matcher"] = rig_.matcher.plugin;
+    summary["units"] = {{"length", "mm"}, {"disparity", "px"}, {"disparity_png_scale", 256}};
+
+    // Between processing stages a few frames are enough to absorb jitter; the policy
+    // acts on the queue at the source, which is the rig's queue_depth.
+    const size_t stageDepth = static_cast<size_t>(std::max(2, rt.matcher_instances));
+    RunState s(options, static_cast<size_t>(rt.queue_depth), stageDepth);
+    bool live = false;
     try {
-        source_->start();
-        Progress progress(options.progress, options.max_frames);
-        while (options.max_frames < 0 || count < options.max_frames) {
-            std::unique_ptr<LentFrame> frame = source_->grab(options.grab_timeout_ms);
-            if (!frame) break;
-            FrameResult r = process(*frame);
-            if (!outDir_.empty()) writeOutputs(r, outDir_);
-            Json f = Json::object();
-            f.set("sequence", r.sequence);
-            f.set("valid_pixel_ratio", r.valid_pixel_ratio);
-            f.set("points", static_cast<uint64_t>(r.cloud.size()));
-            f.set("seconds", r.seconds);
-            f.set("metrics", r.metrics);
-            frames.push(std::move(f));
-            if (onFrame) onFrame(r);
-            ++count;
-            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            progress.update(count, elapsed > 0 ? count / elapsed : 0.0);
-        }
-        Json totals = Json::object();
-        for (auto &slot : evaluators_) {
-            Json figures = Json::object();
-            slot->target = &figures;
-            slot->evaluator->finish();
-            slot->target = nullptr;
-            totals.set(slot->name, std::move(figures));
-        }
-        summary.set("metrics", totals);
-        const std::string stats = source_->statistics();
-        if (!stats.empty()) summary.set("source_statistics", stats);
+        live = sourceIsLive(source_->statistics());
+    } catch (const std::exception &) {
+    }
+    s.policy = rt.policy ? *rt.policy : live ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
+    const size_t jobs = matchers_.size() + 3 * stageDepth + 3;
+    for (size_t i = 0; i < jobs; ++i) s.pool.push_back(std::make_unique<Job>());
+    s.matched.setProducers(static_cast<int>(matchers_.size()));
+
+    summary["runtime"] = {{"policy", s.policy == RuntimeOptions::Policy::Latest ? "latest" : "lossless"},
+                          {"policy_from", rt.policy ? "rig" : live ? "source (live)" : "source (not live)"},
+                          {"queue_depth", rt.queue_depth},
+                          {"matcher_instances", rt.matcher_instances},
+                          {"on_source_error", rt.on_source_error == RuntimeOptions::OnSourceError::Retry ? "retry" : "stop"}};
+    if (rt.on_source_error == RuntimeOptions::OnSourceError::Retry) summary["runtime"]["retry_for_s"] = rt.retry_for_s;
+
+    const auto start = Clock::now();
+    int64_t count = 0;
+    std::optional<FramesFile> frames;
+    try {
+        frames.emplace(outDir_.empty() ? "" : (fs::path(outDir_) / "frames.jsonl").string());
     } catch (const std::exception &e) {
-        failure = e.what();
+        s.fail(e.what());
     }
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    summary.set("frame_count", count);
-    summary.set("seconds", elapsed);
-    summary.set("status", failure.empty() ? "ok" : "failed");
-    if (!failure.empty()) summary.set("error", failure);
+
+    if (!s.aborted) {
+        std::vector<std::thread> threads;
+        threads.emplace_back([&] { acquire(s); });
+        for (auto &m : matchers_) threads.emplace_back([&, mp = m.get()] { rectifyAndMatch(s, *mp); });
+        threads.emplace_back([&] { cloudAndTransforms(s); });
+        threads.emplace_back([&] { evaluate(s); });
+
+        // Stage 5, here: outputs, the frame's line, observers; then the job goes back.
+        Progress progress(options.progress, options.max_frames);
+        while (std::optional<std::unique_ptr<Job>> job = s.evaluated.pop()) {
+            FrameResult &r = (*job)->r;
+            if (!(*job)->failed && !s.aborted) {
+                try {
+                    const auto t0 = Clock::now();
+                    if (!outDir_.empty()) writeOutputs(r, outDir_);
+                    r.seconds += secondsSince(t0);
+                    r.latency_s = secondsSince((*job)->grabbed);
+                    OrderedJson line = OrderedJson::object();
+                    line["index"] = r.index;
+                    line["sequence"] = r.sequence;
+                    line["valid_pixel_ratio"] = r.valid_pixel_ratio;
+                    line["points"] = r.cloud.size();
+                    line["seconds"] = r.seconds;
+                    line["latency_s"] = r.latency_s;
+                    line["metrics"] = r.metrics;
+                    frames->write(line);
+                    if (onFrame) onFrame(r);
+                    for (FrameObserver *o : observers_) o->onFrame(r);
+                    ++count;
+                    const double elapsed = secondsSince(start);
+                    progress.update(count, elapsed > 0 ? count / elapsed : 0.0);
+                } catch (const std::exception &e) {
+                    s.fail(e.what());
+                }
+            }
+            // Views into the lent frame must not outlive it; owned buffers stay for reuse.
+            if (calibration_.rectified) {
+                r.rectified_left.release();
+                r.rectified_right.release();
+            }
+            r.frame = nullptr;
+            (*job)->frame.reset();
+            s.giveJob(std::move(*job));
+        }
+        for (auto &t : threads) t.join();
+    }
+
+    const bool interrupted = s.stopRequested() && !s.endOfStream;
+    std::string failure = s.failure;
+    if (failure.empty()) {
+        try {
+            OrderedJson totals = OrderedJson::object();
+            for (auto &slot : evaluators_) {
+                OrderedJson figures = OrderedJson::object();
+                slot->target = &figures;
+                slot->evaluator->finish();
+                slot->target = nullptr;
+                totals[slot->name] = std::move(figures);
+            }
+            summary["metrics"] = totals;
+        } catch (const std::exception &e) {
+            failure = e.what();
+        }
+    }
+    std::string stats;
+    try {
+        stats = source_->statistics();
+    } catch (const std::exception &e) {
+        spdlog::warn("source statistics: {}", e.what());
+    }
+    const double elapsed = secondsSince(start);
+    summary["frame_count"] = count;
+    summary["frames_grabbed"] = s.grabbed;
+    summary["seconds"] = elapsed;
+    summary["frames_per_second"] = elapsed > 0 ? count / elapsed : 0.0;
+    summary["status"] = !failure.empty() ? "failed" : interrupted ? "interrupted" : "ok";
+    if (!failure.empty()) summary["error"] = failure;
+    if (!outDir_.empty()) summary["frames_file"] = "frames.jsonl";
+
+    OrderedJson dropped = OrderedJson::object();
+    dropped["by_policy"] = s.droppedByPolicy;
+    OrderedJson camera = OrderedJson::object();
+    int64_t unpaired = 0;
+    if (!stats.empty()) {
+        summary["source_statistics"] = stats;
+        try {
+            const YAML::Node n = YAML::Load(stats);
+            if (n.IsMap() && n["unpaired"] && n["unpaired"].IsScalar()) unpaired = n["unpaired"].as<int64_t>(0);
+            sourceDrops(n, "", camera);
+        } catch (const YAML::Exception &) {
+        }
+    }
+    dropped["by_pairing"] = unpaired;
+    int64_t cameraTotal = 0;
+    for (const auto &[k, v] : camera.items()) cameraTotal += v.get<int64_t>();
+    dropped["by_camera_or_transport"] = cameraTotal;
+    dropped["camera_or_transport"] = camera;
+    dropped["total"] = s.droppedByPolicy + unpaired + cameraTotal;
+    summary["dropped"] = dropped;
+    if (s.sourceErrors > 0 || rt.on_source_error == RuntimeOptions::OnSourceError::Retry)
+        summary["source_errors"] = {{"outages", s.sourceErrors}, {"recovered", s.recoveries}, {"last", s.lastSourceError}};
     if (calibrationReady_) {
-        summary.set("calibration", Json::object()
-                                       .set("baseline_mm", calibration_.baselineMm())
-                                       .set("focal_length_px", calibration_.focalLengthPx())
-                                       .set("image_width", calibration_.image_size.width)
-                                       .set("image_height", calibration_.image_size.height));
+        summary["calibration"] = {{"baseline_mm", calibration_.baselineMm()},
+                                  {"focal_length_px", calibration_.focalLengthPx()},
+                                  {"image_width", calibration_.image_size.width},
+                                  {"image_height", calibration_.image_size.height}};
     }
-    writeSummary();
+    if (!outDir_.empty()) writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump(2));
     if (!failure.empty()) throw Error(failure);
     return summary;
 }

@@ -1,38 +1,83 @@
 // SPDX-License-Identifier: MIT
 // The pipeline of METHOD.md (Fig. 2b): acquire -> rectify -> disparity -> cloud in
-// camera coordinates -> cloud transforms (ground frame, Eq. 1) -> evaluators -> outputs.
+// camera coordinates -> cloud transforms (ground frame, Eq. 1) -> evaluators -> outputs,
+// run as stages on their own threads joined by bounded queues (README "Runtime").
 #pragma once
 
 #include "config/rig_config.hpp"
 #include "core/calibration.hpp"
 #include "core/cloud.hpp"
-#include "core/json.hpp"
 #include "host/plugin_host.hpp"
 
+#include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace binocle {
 
 struct RunOptions {
-    int64_t max_frames = -1;   // < 0: until the source ends
+    int64_t max_frames = -1;   // frames taken from the source; < 0: until it ends
     std::string out_dir;       // empty: write nothing
     bool progress = true;      // a progress line on stderr
     int32_t grab_timeout_ms = 5000;
+    // Polled by the run: once true, acquisition stops, the frames in flight are finished
+    // and the summary says `interrupted` (StopSignalGuard::requested() for signals).
+    const std::atomic<bool> *stop = nullptr;
 };
 
-// What one frame produced, for callers that want more than files (experiments, tests).
+// What one frame produced, for callers that want more than files (experiments, tests,
+// viewers). Handed to observers on the writer stage; its images and cloud live in pooled
+// buffers that the next frames reuse, so they are valid during the call only.
 struct FrameResult {
-    uint64_t sequence = 0;
+    uint64_t index = 0;    // 0, 1, 2 ... frames processed in this run (after drops)
+    uint64_t sequence = 0; // the source's sequence number
+    const LentFrame *frame = nullptr; // as the source lent it (extras, metadata)
     cv::Mat rectified_left, rectified_right;
     cv::Mat disparity; // CV_32F
     double valid_pixel_ratio = 0; // share of pixels with a disparity
     Cloud cloud;       // after transforms
-    Json metrics;      // {evaluator: {metric: value}}
+    nlohmann::ordered_json metrics; // {evaluator: {metric: value}}
     std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
-    double seconds = 0;
+    double seconds = 0;   // processing time of the frame, all stages added
+    double latency_s = 0; // from the grab to the writer stage
+};
+
+// A watcher of a run that must never slow it (a live viewer). `onFrame` is called on the
+// writer stage for every finished frame, in frame order, after the outputs are written;
+// it must return at once: copy what it needs, or skip the frame. LatestFrame does that.
+class FrameObserver {
+public:
+    virtual ~FrameObserver() = default;
+    virtual void onFrame(const FrameResult &frame) = 0;
+};
+
+// A copy of what a display needs from one frame.
+struct FrameSnapshot {
+    uint64_t index = 0, sequence = 0;
+    cv::Mat rectified_left, disparity;
+    Cloud cloud;
+    nlohmann::ordered_json metrics;
+};
+
+// Keeps the newest frame for a consumer on another thread. A frame is copied only when
+// the consumer has taken the previous copy and is not taking one right now; otherwise
+// it is skipped (counted), so a slow consumer costs the run nothing but a try-lock.
+class LatestFrame : public FrameObserver {
+public:
+    void onFrame(const FrameResult &frame) override;
+    // The frame copied since the last take, if any. Any thread.
+    std::optional<FrameSnapshot> take();
+    uint64_t skipped() const { return skipped_.load(); }
+
+private:
+    std::mutex mutex_;
+    std::optional<FrameSnapshot> slot_;
+    std::atomic<uint64_t> skipped_{0};
 };
 
 class Pipeline {
@@ -40,33 +85,46 @@ public:
     Pipeline(const RigConfig &rig, const PluginHost &host);
     ~Pipeline();
 
-    // Runs and returns the summary (also written as summary.json when out_dir is set).
-    // `onFrame` sees every frame's result before it is dropped.
-    Json run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame = {});
+    // Runs and returns the summary (also written as summary.json when out_dir is set,
+    // with one line per frame in frames.jsonl). `onFrame` sees every frame, in order, on
+    // the calling thread; it may take its time (the stages before it wait, or drop frames
+    // under the `latest` policy). Observers (addObserver) must not block.
+    // Throws binocle::Error after writing the summary when the run failed.
+    nlohmann::ordered_json run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame = {});
+
+    // Watches the next runs; the observer must outlive them.
+    void addObserver(FrameObserver *observer) { observers_.push_back(observer); }
 
     const StereoCalibration &calibration() const { return calibration_; }
     Source &source() { return *source_; }
 
 private:
+    struct Job;
+    struct RunState;
     void prepareCalibration(const cv::Size &imageSize);
-    FrameResult process(const LentFrame &frame);
+    void acquire(RunState &s);
+    void rectifyAndMatch(RunState &s, Matcher &matcher);
+    void cloudAndTransforms(RunState &s);
+    void evaluate(RunState &s);
     void writeOutputs(const FrameResult &r, const std::string &dir) const;
 
     RigConfig rig_;
     std::unique_ptr<Source> source_;
-    std::unique_ptr<Matcher> matcher_;
+    std::vector<std::unique_ptr<Matcher>> matchers_; // runtime.matcher_instances of them
     std::vector<std::unique_ptr<CloudTransform>> transforms_;
     struct EvaluatorSlot {
         std::string name;
         std::unique_ptr<Evaluator> evaluator;
-        Json *target = nullptr; // where its figures go right now
+        nlohmann::ordered_json *target = nullptr; // where its figures go right now
         std::vector<std::pair<std::string, double>> *flat = nullptr;
     };
     std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
+    std::vector<FrameObserver *> observers_;
     StereoCalibration calibration_;
     std::string calibrationYaml_;
     bool calibrationReady_ = false;
     cv::Mat map1x_, map1y_, map2x_, map2y_;
+    CloudProjector projector_;
     std::string outDir_;
 };
 

@@ -700,6 +700,7 @@ std::unique_ptr<sdk::Frame> V4l2Source::makeFrame(const std::array<std::optional
 std::string V4l2Source::statistics() {
     YAML::Emitter out;
     out << YAML::BeginMap;
+    out << YAML::Key << "live" << YAML::Value << true; // the host defaults to the latest policy
     out << YAML::Key << "layout" << YAML::Value << (settings_.sideBySide ? "side_by_side" : "two_devices");
     out << YAML::Key << "pixel_format" << YAML::Value << fourccText(settings_.fourcc);
     out << YAML::Key << "color" << YAML::Value << (settings_.bgr ? "bgr" : "gray");

@@ -512,6 +512,7 @@ std::string VidereSource::statistics() {
     const CameraInfo info = c.camera().info();
     YAML::Emitter out;
     out << YAML::BeginMap;
+    out << YAML::Key << "live" << YAML::Value << true; // the host defaults to the latest policy
     out << YAML::Key << "guid" << YAML::Value << guidText(info.guid);
     out << YAML::Key << "vendor" << YAML::Value << info.vendor;
     out << YAML::Key << "model" << YAML::Value << info.model;

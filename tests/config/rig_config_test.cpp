@@ -156,3 +156,58 @@ TEST(Nearest, FindsCloseNamesOnly) {
 }
 
 } // namespace
+
+namespace {
+
+TEST_F(RigConfigTest, RuntimeBlockDefaultsAndValues) {
+    RigConfig plain = loadRig(write(rig()), {}, *host_);
+    EXPECT_FALSE(plain.runtime.policy.has_value()); // the source decides
+    EXPECT_EQ(plain.runtime.queue_depth, 4);
+    EXPECT_EQ(plain.runtime.matcher_instances, 1);
+    EXPECT_EQ(plain.runtime.on_source_error, RuntimeOptions::OnSourceError::Stop);
+
+    RigConfig r = loadRig(write(rig() + "runtime:\n  policy: latest\n  queue_depth: 8\n  matcher_instances: 2\n"
+                                        "  on_source_error: retry\n  retry_for_s: 2.5\n"),
+                          {}, *host_);
+    ASSERT_TRUE(r.runtime.policy.has_value());
+    EXPECT_EQ(*r.runtime.policy, RuntimeOptions::Policy::Latest);
+    EXPECT_EQ(r.runtime.queue_depth, 8);
+    EXPECT_EQ(r.runtime.matcher_instances, 2);
+    EXPECT_EQ(r.runtime.on_source_error, RuntimeOptions::OnSourceError::Retry);
+    EXPECT_DOUBLE_EQ(r.runtime.retry_for_s, 2.5);
+
+    RigConfig o = loadRig(write(rig()), {Override::parse("runtime.policy=lossless")}, *host_);
+    ASSERT_TRUE(o.runtime.policy.has_value());
+    EXPECT_EQ(*o.runtime.policy, RuntimeOptions::Policy::Lossless);
+}
+
+TEST_F(RigConfigTest, RuntimeBlockErrorsNameLineKeyValueAndWhatIsExpected) {
+    // The rig has 14 lines; runtime: is line 15, its first key line 16.
+    std::string err = errorOf(rig() + "runtime:\n  polcy: latest\n");
+    EXPECT_NE(err.find("rig.yaml:16:3"), std::string::npos) << err;
+    EXPECT_NE(err.find("unknown key 'polcy'"), std::string::npos) << err;
+    EXPECT_NE(err.find("did you mean 'policy'"), std::string::npos) << err;
+
+    err = errorOf(rig() + "runtime:\n  policy: newest\n");
+    EXPECT_NE(err.find("rig.yaml:16:11"), std::string::npos) << err;
+    EXPECT_NE(err.find("runtime.policy: value 'newest' is not valid: expected one of lossless, latest"), std::string::npos) << err;
+
+    err = errorOf(rig() + "runtime:\n  queue_depth: 0\n");
+    EXPECT_NE(err.find("runtime.queue_depth: value '0' is not valid: expected an integer >= 1"), std::string::npos) << err;
+    err = errorOf(rig() + "runtime:\n  queue_depth: two\n");
+    EXPECT_NE(err.find("runtime.queue_depth: value 'two' is not valid"), std::string::npos) << err;
+    err = errorOf(rig() + "runtime:\n  matcher_instances: 1.5\n");
+    EXPECT_NE(err.find("runtime.matcher_instances: value '1.5' is not valid"), std::string::npos) << err;
+    err = errorOf(rig() + "runtime:\n  on_source_error: retry\n  retry_for_s: -1\n");
+    EXPECT_NE(err.find("rig.yaml:17:16"), std::string::npos) << err;
+    EXPECT_NE(err.find("expected a positive number of seconds"), std::string::npos) << err;
+    err = errorOf(rig() + "runtime:\n  retry_for_s: 5\n");
+    EXPECT_NE(err.find("is only used with on_source_error: retry"), std::string::npos) << err;
+    err = errorOf(rig() + "runtime: fast\n");
+    EXPECT_NE(err.find("runtime: expected a map"), std::string::npos) << err;
+    err = errorOf(rig(), {Override::parse("runtime.on_source_error=ignore")});
+    EXPECT_NE(err.find("command line --set runtime.on_source_error=ignore"), std::string::npos) << err;
+    EXPECT_NE(err.find("expected one of stop, retry"), std::string::npos) << err;
+}
+
+} // namespace

@@ -135,10 +135,13 @@ TEST_F(RunCommand, MocksRunEndToEnd) {
     const std::string summary = readAll(dir_.str("out/summary.json"));
     EXPECT_THAT(summary, HasSubstr("\"status\": \"ok\""));
     EXPECT_THAT(summary, HasSubstr("\"frame_count\": 3"));
-    EXPECT_THAT(summary, HasSubstr("\"points\": 1536"));
-    EXPECT_THAT(summary, HasSubstr("\"cloud_points\": 1536"));
-    EXPECT_THAT(summary, HasSubstr("\"valid_disparity_percent\": 100"));
     EXPECT_THAT(summary, HasSubstr("\"frames_total\": 3"));
+    // Per-frame figures: one line per frame in frames.jsonl.
+    const std::string frames = readAll(dir_.str("out/frames.jsonl"));
+    EXPECT_EQ(std::count(frames.begin(), frames.end(), '\n'), 3);
+    EXPECT_THAT(frames, HasSubstr("\"points\":1536"));
+    EXPECT_THAT(frames, HasSubstr("\"cloud_points\":1536.0"));
+    EXPECT_THAT(frames, HasSubstr("\"valid_disparity_percent\":100.0"));
     // Every frame the source lent came back.
     EXPECT_THAT(summary, HasSubstr("lent: 3\\nreleased: 3\\n"));
 }

@@ -161,7 +161,8 @@ TEST(PluginLoading, SettingsTablesAreReadFromCAndCppPlugins) {
     std::vector<std::string> names;
     for (const auto &d : fixture("mock_source", BINOCLE_KIND_STEREO_SOURCE).params()) names.emplace_back(d.name);
     EXPECT_EQ(names, (std::vector<std::string>{"frames", "width", "height", "disparity_px", "baseline_mm", "focal_length_px",
-                                               "publish_calibration"}));
+                                               "publish_calibration", "live", "frame_interval_ms", "fail_after", "fail_for_ms",
+                                               "fail_code"}));
 }
 
 } // namespace

@@ -159,6 +159,7 @@ TEST(Gige, OpensByAddressAndByDeviceIdAndPairsSoftwareTriggeredImages) {
     }
     const YAML::Node st = statisticsOf(*src);
     EXPECT_EQ(st["frames"].as<int>(), 8);
+    EXPECT_TRUE(st["live"].as<bool>()); // a camera: the host's default policy is latest
     EXPECT_EQ(st["cameras"][0]["role"].as<std::string>(), "left");
     EXPECT_GE(st["cameras"][0]["completed_buffers"].as<int>(), 8);
     EXPECT_EQ(st["cameras"][1]["missing_packets"].as<int>(), 0);

@@ -93,6 +93,7 @@ TEST_F(V4l2, TwoGreyDevicesDeliverPairsInMappedBuffersWithoutCopy) {
     EXPECT_EQ(st["frames"].as<int>(), 3);
     EXPECT_TRUE(st["zero_copy"].as<bool>());
     EXPECT_EQ(st["unpaired"].as<int>(), 0);
+    EXPECT_TRUE(st["live"].as<bool>()); // a camera: the host's default policy is latest
 }
 
 TEST_F(V4l2, ALentBufferReleasedFromAnotherThreadIsQueuedAgain) {

@@ -182,6 +182,7 @@ TEST_F(Videre, DeliversLeftAndRightFromTheInterleavedFrameInTheDmaBuffer) {
     EXPECT_EQ(st["frames"].as<int>(), 3);
     EXPECT_EQ(st["enqueued_on_release"].as<int>(), 3);
     EXPECT_EQ(st["guid"].as<std::string>(), "0x00b09d0100a1b2c3");
+    EXPECT_TRUE(st["live"].as<bool>()); // a camera: the host's default policy is latest
 }
 
 TEST_F(Videre, LeftByteSaysWhichByteIsLeftAndGettingItWrongSwapsTheImages) {
