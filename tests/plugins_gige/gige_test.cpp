@@ -15,12 +15,18 @@
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 namespace {
@@ -761,6 +767,92 @@ TEST(GigeExternal, RecordAtCameraRateNamesEveryPairLost) {
     int64_t n = 0;
     while (back.grab(1000)) ++n;
     EXPECT_EQ(n, written);
+}
+
+// `binocle run` with `on_source_error: retry`: the right camera is killed (its process
+// ends, as a camera that loses power) and started again mid-run; the run goes on once the
+// plugin has reconnected, and frames.jsonl holds frames from before and after.
+std::string readText(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+int linesIn(const std::string &path) {
+    std::ifstream in(path);
+    int n = 0;
+    for (std::string line; std::getline(in, line);) n += line.empty() ? 0 : 1;
+    return n;
+}
+
+TEST(GigeExternal, RunRidesOutACameraKilledAndRestarted) {
+    ExternalFakeCamera left(kLeftAddress, "EXTL0001"), right(kRightAddress, "EXTR0001");
+    std::string why;
+    if (!left.start(&why) || !right.start(&why)) GTEST_SKIP() << why;
+    binocle::test::TempDir dir;
+    {
+        // The simulated rig's calibration at 320x240: the fake cameras' ramp needs no true one.
+        const auto &sim = plugin("sim");
+        Source s(sim, binocle::paramsFromYaml(sim, "{image_width: 320, image_height: 240}"));
+        binocle::test::writeText(dir.str("calibration.yml"), s.calibration());
+    }
+    binocle::test::writeText(dir.str("rig.yaml"),
+                             "name: gige-retry\nsource: {plugin: gige, " + kCameras +
+                                 ", width: 320, height: 240, trigger: free_run, frame_rate_hz: 20, pair_tolerance_ms: 25,"
+                                 " lost_after_ms: 300, retry_interval_ms: 200, calibration: " + dir.str("calibration.yml") + "}\n"
+                                 "matcher: {plugin: bm, num_disparities: 16, block_size: 9}\n"
+                                 "outputs: {disparity_png: false, disparity_color: false, cloud_ply: false}\n"
+                                 "runtime: {on_source_error: retry, retry_for_s: 30}\n");
+    const int frames = 60;
+    const std::string out = dir.str("out"), log = dir.str("run.log");
+    const std::string rig = dir.str("rig.yaml"), count = std::to_string(frames);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(fd, 1);
+        ::dup2(fd, 2);
+        ::setenv("BINOCLE_PLUGIN_PATH", BINOCLE_BUILD_PLUGIN_DIR, 1);
+        ::execl(BINOCLE_CLI, BINOCLE_CLI, "run", rig.c_str(), "--out", out.c_str(), "--frames", count.c_str(), "--quiet",
+                static_cast<char *>(nullptr));
+        ::_exit(127);
+    }
+    const std::string jsonl = out + "/frames.jsonl";
+    auto waitForLines = [&](int n, int seconds) {
+        const auto t0 = Clock::now();
+        while (linesIn(jsonl) < n && msSince(t0) < seconds * 1000.0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        return linesIn(jsonl);
+    };
+    const int beforeKill = waitForLines(15, 60);
+    right.kill();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    const int whileGone = linesIn(jsonl);
+    ASSERT_TRUE(right.start(&why)) << why;
+    const auto restarted = Clock::now();
+    const int atRestart = linesIn(jsonl);
+    int status = 0;
+    while (::waitpid(pid, &status, WNOHANG) == 0 && msSince(restarted) < 90000)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (::waitpid(pid, &status, WNOHANG) == 0) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        FAIL() << "binocle run did not finish within 90 s of the restart; its log:\n" << readText(log);
+    }
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readText(log);
+    const auto summary = nlohmann::ordered_json::parse(readText(out + "/summary.json"));
+    EXPECT_EQ(summary["status"], "ok") << summary.dump(2);
+    EXPECT_EQ(summary["frame_count"], frames);
+    EXPECT_GE(summary["source_errors"]["outages"].get<int>(), 1) << summary.dump(2);
+    EXPECT_GE(summary["source_errors"]["recovered"].get<int>(), 1) << summary.dump(2);
+    EXPECT_NE(summary["source_errors"]["last"].get<std::string>().find("127.0.0.3 (right)"), std::string::npos) << summary.dump(2);
+    EXPECT_EQ(linesIn(jsonl), frames);
+    EXPECT_GE(beforeKill, 15) << "frames before the camera was killed";
+    EXPECT_LT(atRestart, frames) << "frames after the camera came back";
+    std::printf("[ figures  ] binocle run, right camera killed after %d frames, back 1.5 s later: %d frames while it was gone "
+                "(in flight), %d after it came back, %d in all; %d outage(s), %d recovered\n",
+                beforeKill, whileGone - beforeKill, frames - atRestart, frames, summary["source_errors"]["outages"].get<int>(),
+                summary["source_errors"]["recovered"].get<int>());
 }
 
 // ---- Shipped rigs -------------------------------------------------------------------------------
