@@ -6,6 +6,7 @@
 #include "pipeline/recorder.hpp"
 
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <csignal>
@@ -30,6 +31,9 @@ struct RecordArgs {
     std::string out;
     int64_t frames = -1;
     int32_t timeout_ms = 5000;
+    int png_compression = 1;
+    int writer_threads = 0; // 0: the writer's default
+    std::string when_behind; // empty: from the source (drop when live)
     bool statistics = false, quiet = false;
 };
 
@@ -43,12 +47,27 @@ int record(const RecordArgs &args) {
     options.grab_timeout_ms = args.timeout_ms;
     options.progress = !args.quiet;
     options.stop = &stopRequested;
+    options.writer.png_compression = args.png_compression;
+    options.writer.threads = args.writer_threads;
+    if (!args.when_behind.empty()) options.drop_when_behind = args.when_behind == "drop";
     std::signal(SIGINT, onStopSignal);
     std::signal(SIGTERM, onStopSignal);
     RecordResult r = recordRig(rig, args.out, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, args.out, r.seconds);
+    // Where every pair that was not written went (also in DIR/summary.json).
+    const nlohmann::ordered_json lost = recordingSummary(r)["lost"];
+    std::string where = "binocle record: " + std::to_string(r.grabbed) + " pair(s) taken from the source, " +
+                        std::to_string(r.dropped_by_writer) + " dropped because the writers were behind (" +
+                        lost["when_writers_behind"].get<std::string>() + " when behind)";
+    if (lost.contains("unpaired_images")) where += "; source: " + lost["unpaired_images"].dump() + " image(s) left unpaired";
+    if (lost.contains("cameras"))
+        for (const auto &[role, c] : lost["cameras"].items())
+            where += "; " + role + ": " + std::to_string(c.value("images_sent", int64_t{-1})) + " image(s) sent, " +
+                     std::to_string(c.value("lost_in_camera_or_transport", int64_t{0})) + " lost in the camera or transport, " +
+                     std::to_string(c.value("lost_in_pairing", int64_t{0})) + " in pairing";
+    spdlog::info("{}", where);
     if (!r.source_statistics.empty() && args.statistics) std::cout << r.source_statistics;
     if (!r.error.empty()) {
         spdlog::error("{}", r.error);
@@ -65,9 +84,11 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
               "  frames.csv        sequence,timestamp_left_ns,timestamp_right_ns,left,right\n"
               "  calibration.yml   the rig's calibration file, else the source's calibration\n"
               "  rig.yaml          the rig as resolved (after --set)\n"
-              "Each frame's images are written (temporary file, fsync, rename) before its\n"
-              "frames.csv line, which is flushed and fsync'ed: a recording cut short (process\n"
-              "killed, power lost) plays back up to its last complete frame. Replay it with\n"
+              "Each pair is copied at once (the camera has its buffers back) and encoded and\n"
+              "written by a pool of threads (temporary file, fsync, rename); frames.csv rows\n"
+              "follow in batches, each row only once its images are durable, and are fsync'ed:\n"
+              "a recording cut short (process killed, power lost) plays back up to its last\n"
+              "row. summary.json gives the pairs taken, written and lost, and where. Replay it with\n"
               "  source: {plugin: replay, folder: DIR}\n"
               "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
               [](CLI::App &app) -> Runner {
@@ -77,12 +98,25 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
                                  "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
                       ->type_name("DIR")
                       ->required();
-                  app.add_option("--frames", args->frames, "stop after N frames (default: until the source ends or Ctrl-C)")
+                  app.add_option("--frames", args->frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)")
                       ->type_name("N")
                       ->check(atLeast(1));
                   app.add_option("--timeout-ms", args->timeout_ms, "longest wait for one frame (default 5000)")
                       ->type_name("MS")
                       ->check(atLeast(1));
+                  app.add_option("--png-compression", args->png_compression,
+                                 "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
+                      ->type_name("L")
+                      ->check(CLI::Range(0, 9));
+                  app.add_option("--writer-threads", args->writer_threads,
+                                 "threads that encode and write images (default: two per core, 4..16)")
+                      ->type_name("N")
+                      ->check(atLeast(1));
+                  app.add_option("--when-behind", args->when_behind,
+                                 "when the writers fall behind: make the source wait, or drop the pair and count it "
+                                 "(default: drop for a live source such as cameras, wait for files and simulations)")
+                      ->type_name("wait|drop")
+                      ->check(CLI::IsMember({"wait", "drop"}));
                   app.add_flag("--statistics", args->statistics, "print the source's statistics (YAML) at the end");
                   app.add_flag("--quiet", args->quiet, "no progress display");
                   return [args] { return record(*args); };

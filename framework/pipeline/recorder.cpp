@@ -9,14 +9,20 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <fcntl.h>
 #include <filesystem>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+#include <thread>
 #include <unistd.h>
 #include <vector>
+#include <yaml-cpp/yaml.h>
 
 namespace fs = std::filesystem;
 
@@ -70,8 +76,171 @@ std::string RecordingWriter::imagePath(const std::string &side, uint64_t sequenc
     return side + "/" + name;
 }
 
-RecordingWriter::RecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml)
-    : dir_(dir) {
+// The writer's threads: `threads` workers encode and write images, one committer appends
+// rows in submission order once their images are durable.
+struct RecordingWriter::Pool {
+    struct Job {
+        uint64_t sequence = 0;
+        int64_t tl = 0, tr = 0;
+        cv::Mat images[2];
+        bool rgb = false;
+        bool done = false;
+        std::string error;
+    };
+
+    std::string dir, csvPath;
+    RecordingWriterOptions options;
+    int csvFd = -1, dirFds[2] = {-1, -1};
+
+    mutable std::mutex mutex;
+    std::condition_variable workAvailable, jobDone, roomAvailable, committed;
+    std::deque<std::shared_ptr<Job>> todo;    // waiting for a worker
+    std::deque<std::shared_ptr<Job>> inOrder; // submitted, row not yet durable
+    int64_t inMemory = 0;                     // frames whose images are held (todo + being written)
+    int64_t rows = 0, submitted = 0;
+    bool stopping = false;          // workers: finish the queue and end
+    bool committerStopping = false; // committer: list what is done and end (workers are gone)
+    bool flushRequested = false;
+    std::string error; // first failure; nothing after it is listed
+    RecordingWriterStats stats;
+    std::vector<std::thread> workers;
+    std::thread committer;
+
+    ~Pool() {
+        for (int fd : {csvFd, dirFds[0], dirFds[1]})
+            if (fd >= 0) ::close(fd);
+    }
+
+    void work() {
+        std::unique_lock<std::mutex> lock(mutex);
+        for (;;) {
+            workAvailable.wait(lock, [&] { return stopping || !todo.empty(); });
+            if (todo.empty()) return;
+            std::shared_ptr<Job> job = todo.front();
+            todo.pop_front();
+            lock.unlock();
+            double encodeMs = 0, writeMs = 0;
+            try {
+                writeImages(*job, encodeMs, writeMs);
+            } catch (const std::exception &e) {
+                job->error = e.what();
+            }
+            job->images[0].release();
+            job->images[1].release();
+            lock.lock();
+            job->done = true;
+            --inMemory;
+            stats.encode_ms += encodeMs;
+            stats.write_ms += writeMs;
+            roomAvailable.notify_all();
+            jobDone.notify_all();
+        }
+    }
+
+    void writeImages(Job &job, double &encodeMs, double &writeMs) const {
+        for (int i = 0; i < 2; ++i) {
+            const std::string file = (fs::path(dir) / imagePath(i == 0 ? "left" : "right", job.sequence)).string();
+            const auto t0 = std::chrono::steady_clock::now();
+            cv::Mat toWrite = job.images[i];
+            if (job.rgb && toWrite.channels() == 3) cv::cvtColor(toWrite, toWrite, cv::COLOR_RGB2BGR);
+            std::vector<uchar> png;
+            try {
+                if (!cv::imencode(".png", toWrite, png, {cv::IMWRITE_PNG_COMPRESSION, options.png_compression}))
+                    throw Error("record: cannot encode " + file);
+            } catch (const cv::Exception &e) {
+                throw Error("record: cannot encode " + file + ": " + e.err);
+            }
+            const auto t1 = std::chrono::steady_clock::now();
+            // Temporary file, fsync, rename: the image is complete on disk before its row.
+            writeFileAtomic(file, std::string(png.begin(), png.end()));
+            encodeMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
+            writeMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+        }
+    }
+
+    // Rows of the finished frames at the head of the order, once a batch is full, the
+    // interval has passed, or someone waits for them.
+    void commitLoop() {
+        std::unique_lock<std::mutex> lock(mutex);
+        auto readyCount = [&] {
+            size_t n = 0;
+            while (n < inOrder.size() && inOrder[n]->done) ++n;
+            return n;
+        };
+        for (;;) {
+            jobDone.wait_for(lock, std::chrono::milliseconds(options.sync_interval_ms), [&] {
+                const size_t ready = readyCount();
+                return ready >= static_cast<size_t>(options.sync_batch_frames) ||
+                       ((flushRequested || committerStopping) && ready > 0) || (committerStopping && inOrder.empty()) ||
+                       !error.empty();
+            });
+            std::vector<std::shared_ptr<Job>> batch;
+            for (size_t n = readyCount(), i = 0; i < n && error.empty(); ++i) {
+                if (!inOrder.front()->error.empty()) {
+                    error = inOrder.front()->error;
+                    break;
+                }
+                batch.push_back(inOrder.front());
+                inOrder.pop_front();
+            }
+            if (!batch.empty()) {
+                lock.unlock();
+                std::string failure;
+                try {
+                    writeRows(batch);
+                } catch (const std::exception &e) {
+                    failure = e.what();
+                }
+                lock.lock();
+                if (failure.empty()) {
+                    rows += static_cast<int64_t>(batch.size());
+                    ++stats.syncs;
+                } else if (error.empty()) {
+                    error = failure;
+                }
+            }
+            if (!error.empty()) inOrder.clear(); // nothing after a failure is listed
+            if (rows == submitted) flushRequested = false;
+            committed.notify_all();
+            if (committerStopping && (inOrder.empty() || !error.empty())) return;
+        }
+    }
+
+    void writeRows(const std::vector<std::shared_ptr<Job>> &batch) {
+        // The renames of the batch's images are durable before any row names them.
+        for (int i = 0; i < 2; ++i)
+            if (::fsync(dirFds[i]) != 0)
+                throw Error("record: cannot write " + dir + (i == 0 ? "/left" : "/right") + ": fsync failed: " + std::strerror(errno));
+        std::string lines;
+        for (const auto &job : batch)
+            lines += std::to_string(job->sequence) + "," + std::to_string(job->tl) + "," + std::to_string(job->tr) + "," +
+                     imagePath("left", job->sequence) + "," + imagePath("right", job->sequence) + "\n";
+        writeDurably(csvFd, lines, csvPath);
+    }
+
+    void rethrow() const {
+        if (!error.empty()) throw Error(error);
+    }
+};
+
+RecordingWriter::RecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
+                                 const RecordingWriterOptions &options)
+    : dir_(dir), pool_(std::make_unique<Pool>()) {
+    Pool &p = *pool_;
+    p.dir = dir;
+    p.options = options;
+    if (p.options.png_compression < 0 || p.options.png_compression > 9)
+        throw Error("record: PNG compression level = " + std::to_string(p.options.png_compression) + ": expected 0..9");
+    // Each image waits for its fsync (I/O, not CPU): twice as many threads as cores keep
+    // the cores encoding meanwhile.
+    if (p.options.threads <= 0) p.options.threads = std::clamp(2 * static_cast<int>(std::thread::hardware_concurrency()), 4, 16);
+    if (p.options.queue_frames <= 0) p.options.queue_frames = 8 * p.options.threads;
+    p.options.sync_batch_frames = std::max(1, p.options.sync_batch_frames);
+    p.options.sync_interval_ms = std::max(1, p.options.sync_interval_ms);
+    p.stats.threads = p.options.threads;
+    p.stats.png_compression = p.options.png_compression;
+    p.stats.queue_frames = p.options.queue_frames;
+
     std::error_code ec;
     if (fs::exists(dir_, ec)) {
         if (!fs::is_directory(dir_, ec)) throw Error("record: " + dir_ + " exists and is not a folder");
@@ -84,46 +253,201 @@ RecordingWriter::RecordingWriter(const std::string &dir, const std::string &cali
     if (ec) throw Error("record: cannot create " + dir_ + ": " + ec.message());
     if (!calibrationYaml.empty()) writeFileAtomic((fs::path(dir_) / "calibration.yml").string(), calibrationYaml);
     if (!rigYaml.empty()) writeFileAtomic((fs::path(dir_) / "rig.yaml").string(), rigYaml);
-    const std::string csv = (fs::path(dir_) / "frames.csv").string();
+    for (int i = 0; i < 2; ++i) {
+        const std::string side = (fs::path(dir_) / (i == 0 ? "left" : "right")).string();
+        p.dirFds[i] = ::open(side.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (p.dirFds[i] < 0) throw Error("record: cannot open " + side + ": " + std::strerror(errno));
+    }
+    p.csvPath = (fs::path(dir_) / "frames.csv").string();
     // O_EXCL: even a recorder racing for the same folder cannot truncate another's index.
-    csvFd_ = ::open(csv.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_APPEND | O_CLOEXEC, 0644);
-    if (csvFd_ < 0) throw Error("record: cannot create " + csv + ": " + std::strerror(errno));
-    writeDurably(csvFd_, kCsvHeader, csv);
+    p.csvFd = ::open(p.csvPath.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_APPEND | O_CLOEXEC, 0644);
+    if (p.csvFd < 0) throw Error("record: cannot create " + p.csvPath + ": " + std::strerror(errno));
+    writeDurably(p.csvFd, kCsvHeader, p.csvPath);
+
+    for (int i = 0; i < p.options.threads; ++i) p.workers.emplace_back([&p] { p.work(); });
+    p.committer = std::thread([&p] { p.commitLoop(); });
 }
 
 RecordingWriter::~RecordingWriter() {
-    if (csvFd_ >= 0) ::close(csvFd_);
+    Pool &p = *pool_;
+    {
+        std::lock_guard<std::mutex> lock(p.mutex);
+        p.stopping = true;
+    }
+    p.workAvailable.notify_all();
+    for (auto &t : p.workers) t.join();
+    {
+        std::lock_guard<std::mutex> lock(p.mutex);
+        p.committerStopping = true;
+    }
+    p.jobDone.notify_all();
+    p.committer.join();
+}
+
+bool RecordingWriter::submit(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, cv::Mat left, cv::Mat right,
+                             bool rgb, bool wait) {
+    Pool &p = *pool_;
+    auto job = std::make_shared<Pool::Job>();
+    job->sequence = sequence;
+    job->tl = timestampLeftNs;
+    job->tr = timestampRightNs;
+    job->images[0] = std::move(left);
+    job->images[1] = std::move(right);
+    job->rgb = rgb;
+    {
+        std::unique_lock<std::mutex> lock(p.mutex);
+        p.rethrow();
+        if (p.inMemory >= p.options.queue_frames) {
+            if (!wait) return false;
+            p.roomAvailable.wait(lock, [&] { return p.inMemory < p.options.queue_frames || !p.error.empty(); });
+            p.rethrow();
+        }
+        p.todo.push_back(job);
+        p.inOrder.push_back(job);
+        ++p.inMemory;
+        ++p.submitted;
+        p.stats.max_queued = std::max(p.stats.max_queued, p.inMemory);
+    }
+    p.workAvailable.notify_one();
+    return true;
+}
+
+bool RecordingWriter::submit(const LentFrame &frame, bool wait) {
+    const binocle_stereo_frame &f = frame.raw();
+    bool rgbLeft = false, rgbRight = false;
+    // Copies: the source's buffers go back as soon as the caller releases the frame.
+    cv::Mat left = view(f.left, rgbLeft).clone(), right = view(f.right, rgbRight).clone();
+    return submit(f.sequence, f.timestamp_left_ns, f.timestamp_right_ns, std::move(left), std::move(right), rgbLeft || rgbRight, wait);
+}
+
+void RecordingWriter::finish() {
+    Pool &p = *pool_;
+    std::unique_lock<std::mutex> lock(p.mutex);
+    p.flushRequested = true;
+    p.jobDone.notify_all();
+    p.committed.wait(lock, [&] { return p.rows == p.submitted || !p.error.empty(); });
+    p.rethrow();
 }
 
 void RecordingWriter::append(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, const cv::Mat &left,
                              const cv::Mat &right, bool rgb) {
-    const std::string paths[2] = {imagePath("left", sequence), imagePath("right", sequence)};
-    const cv::Mat *images[2] = {&left, &right};
-    for (int i = 0; i < 2; ++i) {
-        const std::string file = (fs::path(dir_) / paths[i]).string();
-        cv::Mat toWrite = *images[i];
-        if (rgb && toWrite.channels() == 3) cv::cvtColor(toWrite, toWrite, cv::COLOR_RGB2BGR);
-        std::vector<uchar> png;
-        try {
-            // Level 1: lossless all the same, several times faster than the default.
-            if (!cv::imencode(".png", toWrite, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) throw Error("cannot encode " + file);
-        } catch (const cv::Exception &e) {
-            throw Error("record: cannot encode " + file + ": " + e.err);
-        }
-        // Temporary file, fsync, rename: the image is complete on disk before its line.
-        writeFileAtomic(file, std::string(png.begin(), png.end()));
-    }
-    const std::string line = std::to_string(sequence) + "," + std::to_string(timestampLeftNs) + "," +
-                             std::to_string(timestampRightNs) + "," + paths[0] + "," + paths[1] + "\n";
-    writeDurably(csvFd_, line, (fs::path(dir_) / "frames.csv").string());
-    ++frames_;
+    submit(sequence, timestampLeftNs, timestampRightNs, left.clone(), right.clone(), rgb, true);
+    finish();
 }
 
 void RecordingWriter::append(const LentFrame &frame) {
-    const binocle_stereo_frame &f = frame.raw();
-    bool rgbLeft = false, rgbRight = false;
-    const cv::Mat left = view(f.left, rgbLeft), right = view(f.right, rgbRight);
-    append(f.sequence, f.timestamp_left_ns, f.timestamp_right_ns, left, right, rgbLeft || rgbRight);
+    submit(frame, true);
+    finish();
+}
+
+int64_t RecordingWriter::frameCount() const {
+    std::lock_guard<std::mutex> lock(pool_->mutex);
+    return pool_->rows;
+}
+
+RecordingWriterStats RecordingWriter::stats() const {
+    std::lock_guard<std::mutex> lock(pool_->mutex);
+    return pool_->stats;
+}
+
+namespace {
+
+// A YAML scalar as JSON: integers, reals and booleans as such, anything else as text.
+nlohmann::ordered_json jsonOf(const YAML::Node &node) {
+    if (node.IsMap()) {
+        nlohmann::ordered_json o = nlohmann::ordered_json::object();
+        for (const auto &kv : node) o[kv.first.as<std::string>()] = jsonOf(kv.second);
+        return o;
+    }
+    if (node.IsSequence()) {
+        nlohmann::ordered_json a = nlohmann::ordered_json::array();
+        for (const auto &item : node) a.push_back(jsonOf(item));
+        return a;
+    }
+    if (!node.IsScalar()) return nullptr;
+    const std::string text = node.Scalar();
+    if (node.Tag() != "!") { // not quoted
+        try {
+            size_t used = 0;
+            const long long i = std::stoll(text, &used);
+            if (used == text.size()) return i;
+            const double d = std::stod(text, &used);
+            if (used == text.size()) return d;
+        } catch (const std::exception &) {
+        }
+        if (text == "true" || text == "false") return text == "true";
+    }
+    return text;
+}
+
+// Counters a source may report (plugin ABI, statistics): images lost in a camera or the
+// transport, and images dropped by pairing. The framework names no plugin: it reads these
+// keys wherever they are, per camera when a list item has a `role`.
+const char *const kTransportKeys[] = {"incomplete_images", "skipped_frame_ids", "corrupt", "dropped_by_driver"};
+
+nlohmann::ordered_json lossesOf(const nlohmann::ordered_json &source) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::object();
+    if (!source.is_object()) return out;
+    if (source.contains("unpaired") && source["unpaired"].is_number_integer()) out["unpaired_images"] = source["unpaired"];
+    auto camera = [&](const nlohmann::ordered_json &item) {
+        nlohmann::ordered_json c = nlohmann::ordered_json::object();
+        int64_t transport = 0;
+        bool any = false;
+        for (const char *key : kTransportKeys)
+            if (item.contains(key) && item[key].is_number_integer()) {
+                transport += item[key].get<int64_t>();
+                any = true;
+            }
+        if (any) c["lost_in_camera_or_transport"] = transport;
+        if (item.contains("unpaired") && item["unpaired"].is_number_integer()) c["lost_in_pairing"] = item["unpaired"];
+        if (any && item.contains("images") && item["images"].is_number_integer())
+            c["images_sent"] = item["images"].get<int64_t>() + transport;
+        return c;
+    };
+    for (const auto &[key, value] : source.items()) {
+        if (!value.is_array()) continue;
+        for (const auto &item : value)
+            if (item.is_object() && item.contains("role")) {
+                nlohmann::ordered_json c = camera(item);
+                if (c.empty()) continue;
+                out["cameras"][item["role"].is_string() ? item["role"].get<std::string>() : item["role"].dump()] = c;
+            }
+    }
+    return out;
+}
+
+} // namespace
+
+nlohmann::ordered_json recordingSummary(const RecordResult &r) {
+    nlohmann::ordered_json j;
+    j["status"] = r.status;
+    j["pairs_taken"] = r.grabbed;
+    j["pairs_written"] = r.frames;
+    j["seconds"] = r.seconds;
+    j["pairs_written_per_s"] = r.seconds > 0 ? r.frames / r.seconds : 0.0;
+    nlohmann::ordered_json source = nullptr;
+    if (!r.source_statistics.empty()) {
+        try {
+            source = jsonOf(YAML::Load(r.source_statistics));
+        } catch (const std::exception &) {
+            source = r.source_statistics; // not YAML: kept as text
+        }
+    }
+    nlohmann::ordered_json lost = lossesOf(source);
+    lost["pairs_dropped_by_writer"] = r.dropped_by_writer;
+    lost["when_writers_behind"] = r.dropped_when_behind ? "drop" : "wait";
+    j["lost"] = lost;
+    const int64_t images = 2 * (r.frames > 0 ? r.frames : 1);
+    j["writer"] = {{"threads", r.writer.threads},
+                   {"png_compression", r.writer.png_compression},
+                   {"queue_frames", r.writer.queue_frames},
+                   {"max_queued_frames", r.writer.max_queued},
+                   {"row_syncs", r.writer.syncs},
+                   {"encode_ms_per_image", r.writer.encode_ms / images},
+                   {"write_ms_per_image", r.writer.write_ms / images}};
+    j["source_statistics"] = source;
+    if (!r.error.empty()) j["error"] = r.error;
+    return j;
 }
 
 RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
@@ -132,26 +456,45 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
     std::string calibration;
     if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
     else calibration = source.calibration();
-    RecordingWriter writer(dir, calibration, rig.resolved_yaml);
+    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
 
     RecordResult result;
+    bool live = false;
+    try {
+        const YAML::Node st = YAML::Load(source.statistics());
+        live = st.IsMap() && st["live"] && st["live"].as<bool>(false);
+    } catch (const std::exception &) {
+    }
+    result.dropped_when_behind = options.drop_when_behind.value_or(live);
     const auto begin = std::chrono::steady_clock::now();
     Progress progress(options.progress, "frame", options.max_frames);
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); };
     try {
         source.start();
-        while (options.max_frames < 0 || writer.frameCount() < options.max_frames) {
-            if (options.stop && options.stop->load()) break;
+        while (options.max_frames < 0 || result.grabbed < options.max_frames) {
+            if (options.stop && options.stop->load()) {
+                result.status = "interrupted";
+                break;
+            }
             std::unique_ptr<LentFrame> frame = source.grab(options.grab_timeout_ms);
             if (!frame) break;
-            writer.append(*frame);
-            frame.reset(); // give the buffer back before waiting for the next one
-            if (onFrame) onFrame(writer.frameCount());
-            progress.update(writer.frameCount(), "recorded");
+            ++result.grabbed;
+            if (!writer.submit(*frame, !result.dropped_when_behind)) ++result.dropped_by_writer;
+            frame.reset(); // the copy is queued: the source has its buffers back
+            if (onFrame) onFrame(result.grabbed);
+            progress.update(writer.frameCount(), "recorded, " + std::to_string(result.dropped_by_writer) +
+                                                     " dropped (writers behind)");
         }
         source.stop();
     } catch (const std::exception &e) {
         result.error = e.what();
+        result.status = "error";
+    }
+    try {
+        writer.finish();
+    } catch (const std::exception &e) {
+        if (result.error.empty()) result.error = e.what();
+        result.status = "error";
     }
     progress.finish();
     try {
@@ -160,6 +503,12 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
     }
     result.frames = writer.frameCount();
     result.seconds = elapsed();
+    result.writer = writer.stats();
+    try {
+        writeFileAtomic((fs::path(dir) / "summary.json").string(), recordingSummary(result).dump(2) + "\n");
+    } catch (const std::exception &e) {
+        spdlog::warn("record: {}", e.what());
+    }
     return result;
 }
 

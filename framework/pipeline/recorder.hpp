@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Recording a rig's source to a folder in the `recording` layout of plugins/replay/README.md:
-// lossless PNG images, frames.csv, calibration.yml and rig.yaml. Every frame is durable
-// before the next one starts, so a recording cut short is readable up to its last frame.
+// lossless PNG images, frames.csv, calibration.yml and rig.yaml. Images are encoded and
+// written off the grab thread; a recording cut short is readable up to its last row.
 #pragma once
 
 #include "config/rig_config.hpp"
@@ -10,62 +10,122 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 namespace binocle {
 
-// Writes one recording folder. Each frame: both images to a temporary file, fsync, rename;
-// then its frames.csv line, flushed and fsync'ed. A frame without its line does not exist.
+// How a RecordingWriter spreads its work.
+struct RecordingWriterOptions {
+    int threads = 0;            // threads that encode and write images; 0 = two per core, 4..16
+    int png_compression = 1;    // zlib level 0..9; 1: lossless all the same, several times faster than 6
+    int queue_frames = 0;       // frames copied and waiting for a thread; 0 = 8 per thread
+    int sync_batch_frames = 16; // frames.csv rows made durable together ...
+    int sync_interval_ms = 200; // ... or after this long, whichever comes first
+};
+
+// What a RecordingWriter did, for the summary.
+struct RecordingWriterStats {
+    int threads = 0;
+    int png_compression = 0;
+    int queue_frames = 0;
+    int64_t max_queued = 0; // most frames waiting at once
+    int64_t syncs = 0;      // batches of rows made durable
+    double encode_ms = 0;   // total PNG encoding time, all threads
+    double write_ms = 0;    // total time writing and fsync'ing image files, all threads
+};
+
+// Writes one recording folder. Frames are copied by the caller's thread and handed to a pool
+// of threads that encode each image to PNG and write it (temporary file, fsync, rename).
+// The frames.csv rows are appended in the order the frames were submitted, in batches:
+// the images of a batch are durable (data fsync'ed, folders fsync'ed for the renames)
+// before its rows are written, and the rows are fsync'ed. A frame without its row does not
+// exist; a row never names an image that a crash could lose.
 class RecordingWriter {
 public:
     // Creates `dir` (and its parents) and frames.csv with its header; writes calibration.yml
     // (when `calibrationYaml` is not empty) and rig.yaml (when `rigYaml` is not empty).
     // Refuses a folder that already holds anything, naming what it holds: nothing already
     // written is ever replaced.
-    RecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml);
+    RecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
+                    const RecordingWriterOptions &options = {});
+    // Finishes the frames submitted (errors are dropped: call finish() to see them).
     ~RecordingWriter();
     RecordingWriter(const RecordingWriter &) = delete;
     RecordingWriter &operator=(const RecordingWriter &) = delete;
 
-    // left, right: GRAY8 (CV_8UC1), BGR8 (CV_8UC3) or RGB8 (CV_8UC3, `rgb` true: stored as
-    // the same colours). Throws binocle::Error naming the file on any write failure.
+    // Writes one frame and returns when its row is durable. left, right: GRAY8 (CV_8UC1),
+    // GRAY16 (CV_16UC1), BGR8 (CV_8UC3) or RGB8 (CV_8UC3, `rgb` true: stored as the same
+    // colours). Throws binocle::Error naming the file on any write failure.
     void append(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, const cv::Mat &left,
                 const cv::Mat &right, bool rgb = false);
     // A frame as a source lent it.
     void append(const LentFrame &frame);
 
-    int64_t frameCount() const { return frames_; }
+    // Copies the frame's images (the source may have its buffers back at once) and queues
+    // them. When the queue is full: waits for room when `wait`, else returns false and
+    // queues nothing. Throws the first write failure of an earlier frame.
+    bool submit(const LentFrame &frame, bool wait);
+    // The same with images the writer takes over (they must not be written to afterwards).
+    bool submit(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, cv::Mat left, cv::Mat right, bool rgb,
+                bool wait);
+    // Waits until every frame submitted is written and its row durable; throws the first
+    // write failure (frames listed before it stay readable).
+    void finish();
+
+    // Frames whose rows are in frames.csv and durable.
+    int64_t frameCount() const;
     const std::string &dir() const { return dir_; }
+    RecordingWriterStats stats() const;
 
     // Image file of a frame, relative to the folder: "left/000017.png".
     static std::string imagePath(const std::string &side, uint64_t sequence);
 
 private:
+    struct Pool;
     std::string dir_;
-    int csvFd_ = -1;
-    int64_t frames_ = 0;
+    std::unique_ptr<Pool> pool_;
 };
 
 struct RecordOptions {
-    int64_t max_frames = -1;         // < 0: until the source ends (or `stop` is set)
+    int64_t max_frames = -1;         // pairs taken from the source; < 0: until it ends (or `stop` is set)
     int32_t grab_timeout_ms = 5000;
     bool progress = true;            // a progress line on stderr
     const std::atomic<bool> *stop = nullptr; // set from elsewhere (a signal) to end cleanly
+    // When the writers fall behind: wait (the source waits too), or drop the pair and count
+    // it. Unset: drop for a live source (its statistics say `live: true`: a camera does not
+    // wait, and a grab thread that waits only moves the loss into the camera's buffers),
+    // wait for any other (files, simulation: nothing is lost).
+    std::optional<bool> drop_when_behind;
+    RecordingWriterOptions writer;
 };
 
 struct RecordResult {
-    int64_t frames = 0;
+    int64_t frames = 0;            // pairs written (rows in frames.csv)
+    int64_t grabbed = 0;           // pairs taken from the source
+    int64_t dropped_by_writer = 0; // pairs taken but not written: the writers were behind
+    bool dropped_when_behind = false;
     double seconds = 0;
     std::string source_statistics; // YAML of the source, when it gives any
-    std::string error;             // empty when the run ended normally
+    RecordingWriterStats writer;
+    std::string status = "complete"; // complete | interrupted | error
+    std::string error;               // empty when the run ended normally
 };
 
 // Records rig.source into `dir`. The calibration written is the rig's calibration file,
 // else the source's own, else none. A failure of the source after the recording has started
 // ends the run and is returned in `error` (the frames already written stay readable);
 // failures before (folder refused, source cannot open) are thrown as binocle::Error.
+// `onFrame` gets the number of pairs taken from the source so far.
+// At the end the folder gets summary.json (recordingSummary) beside frames.csv.
 RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
                        const std::function<void(int64_t frames)> &onFrame = {});
+
+// The run's figures as JSON: pairs taken, written and lost, and where each was lost: in the
+// cameras or the transport, in pairing (from the source's statistics), or by the writers.
+nlohmann::ordered_json recordingSummary(const RecordResult &result);
 
 } // namespace binocle

@@ -5,6 +5,8 @@
 
 #include <binocle/plugin.hpp>
 
+#include <algorithm>
+#include <fstream>
 #include <sstream>
 #include <vector>
 
@@ -270,10 +272,7 @@ void Camera::configure() {
         if (error) fail(BINOCLE_ERR_DEVICE, "trigger_line = " + settings_.trigger_line + " refused: " + error.message());
     }
 
-    if (settings_.packet_size && arv_camera_is_gv_device(camera_)) {
-        arv_camera_gv_set_packet_size(camera_, static_cast<gint>(*settings_.packet_size), error.out());
-        if (error) fail(BINOCLE_ERR_INVALID_ARGUMENT, "packet_size = " + std::to_string(*settings_.packet_size) + " refused: " + error.message());
-    }
+    if (arv_camera_is_gv_device(camera_)) configureTransport();
 
     // What the camera will really send.
     width_ = static_cast<int>(arv_camera_get_integer(camera_, "Width", error.out()));
@@ -298,6 +297,7 @@ void Camera::configure() {
     if (!stream_) fail(BINOCLE_ERR_DEVICE, "cannot open its stream: " + error.message());
     home_ = std::make_shared<BufferHome>(stream_);
     g_object_unref(stream_); // home_ holds the reference now
+    if (ARV_IS_GV_STREAM(stream_)) configureStreamSocket();
 
     if (ARV_IS_GV_DEVICE(device)) {
         auto *lostCopy = new std::shared_ptr<LostState>(lost_);
@@ -305,6 +305,57 @@ void Camera::configure() {
             device, "control-lost", G_CALLBACK(&Camera::onControlLost), lostCopy,
             [](gpointer p, GClosure *) { delete static_cast<std::shared_ptr<LostState> *>(p); }, GConnectFlags(0));
     }
+}
+
+// Why the defaults: Aravis leaves the stream socket's receive buffer at the kernel's default
+// (net.core.rmem_default, 208 KiB here), less than one 640x480 image. A camera sends each
+// image as one burst of packets; whenever the stream thread is not scheduled for the few
+// milliseconds a burst lasts (a busy machine), the kernel drops what does not fit, and at
+// 20-30 fps nearly every image lost packets. The fix is a buffer with room for several
+// images. Larger packets (the largest the path carries, found with Aravis's test packets)
+// cut the number of packets, and so the receiver's work, per image.
+void Camera::configureTransport() {
+    GErrorSlot error;
+    if (settings_.packet_size) {
+        arv_camera_gv_set_packet_size(camera_, static_cast<gint>(*settings_.packet_size), error.out());
+        if (error) fail(BINOCLE_ERR_INVALID_ARGUMENT, "packet_size = " + std::to_string(*settings_.packet_size) + " refused: " + error.message());
+        const gint64 now = arv_camera_gv_get_packet_size(camera_, error.out());
+        if (now != *settings_.packet_size)
+            fail(BINOCLE_ERR_INVALID_ARGUMENT, "packet_size = " + std::to_string(*settings_.packet_size) + " not accepted (the camera set " +
+                                                   std::to_string(now) + ")");
+    } else {
+        // Test packets of decreasing size: the largest that reaches this host unfragmented.
+        // A camera without test packets keeps its own size.
+        arv_camera_gv_auto_packet_size(camera_, error.out());
+    }
+    packetSize_ = arv_camera_gv_get_packet_size(camera_, error.out());
+    if (settings_.packet_delay_ns) {
+        if (!arv_camera_is_feature_available(camera_, "GevSCPD", nullptr))
+            fail(BINOCLE_ERR_UNSUPPORTED, "packet_delay_ns = " + std::to_string(*settings_.packet_delay_ns) + ": the camera has no GevSCPD");
+        arv_camera_gv_set_packet_delay(camera_, *settings_.packet_delay_ns, error.out());
+        if (error)
+            fail(BINOCLE_ERR_INVALID_ARGUMENT, "packet_delay_ns = " + std::to_string(*settings_.packet_delay_ns) + " refused: " + error.message());
+    }
+}
+
+void Camera::configureStreamSocket() {
+    // Room for as many images as the stream has buffers: a burst that waits for the stream
+    // thread is never larger than what the buffers could take anyway.
+    std::ifstream limit("/proc/sys/net/core/rmem_max");
+    if (!(limit >> socketBufferLimitBytes_)) socketBufferLimitBytes_ = 0;
+    if (settings_.socket_buffer_bytes > 0) {
+        socketBufferBytes_ = settings_.socket_buffer_bytes;
+    } else {
+        // What the kernel grants, but never less than two images (a warning tells how to
+        // raise the limit then).
+        socketBufferBytes_ = static_cast<int64_t>(payload_) * settings_.buffers;
+        if (socketBufferLimitBytes_ > 0)
+            socketBufferBytes_ = std::min(socketBufferBytes_, std::max(socketBufferLimitBytes_, 2 * static_cast<int64_t>(payload_)));
+    }
+    socketBufferBytes_ = std::min<int64_t>(socketBufferBytes_, G_MAXINT);
+    g_object_set(stream_, "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_FIXED, "socket-buffer-size",
+                 static_cast<gint>(socketBufferBytes_), "packet-resend",
+                 settings_.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS : ARV_GV_STREAM_PACKET_RESEND_NEVER, nullptr);
 }
 
 void Camera::onStreamEvent(void *data, ArvStreamCallbackType type, ArvBuffer *) {

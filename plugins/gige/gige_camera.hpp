@@ -63,7 +63,10 @@ struct CameraSettings {
     std::optional<double> exposure_us, gain_db, frame_rate_hz;
     std::string trigger = "free_run"; // free_run | software | hardware
     std::string trigger_line = "Line0";
-    std::optional<int64_t> packet_size;
+    std::optional<int64_t> packet_size; // unset: the largest the path carries
+    std::optional<int64_t> packet_delay_ns;
+    int64_t socket_buffer_bytes = 0; // 0: room for `buffers` images
+    bool packet_resend = true;
     bool packet_socket = false; // Aravis's AF_PACKET receiver (see README: reopening)
     int buffers = 8;
 };
@@ -103,6 +106,11 @@ public:
     std::string lostReason() const;
     void markLost(const std::string &why);
     StreamCounters counters() const;
+    // Receive buffer asked for each stream socket, and what the kernel grants at most
+    // (net.core.rmem_max; 0 when unknown). Packet size in use (0 when not GigE Vision).
+    int64_t socketBufferBytes() const { return socketBufferBytes_; }
+    int64_t socketBufferLimitBytes() const { return socketBufferLimitBytes_; }
+    int64_t packetSize() const { return packetSize_; }
 
     // Every device Aravis sees, as "id (address)" list; "none" when empty. Runs a discovery.
     static std::string listDevices();
@@ -114,6 +122,8 @@ private:
         std::shared_ptr<Notifier> notifier;
     };
     void configure();
+    void configureTransport();    // packet size and delay, on the camera
+    void configureStreamSocket(); // receive buffer and resend policy, on the stream
     [[noreturn]] void fail(int32_t code, const std::string &what) const;
     static void onStreamEvent(void *data, ArvStreamCallbackType type, ArvBuffer *buffer);
     static void onControlLost(ArvGvDevice *device, void *data);
@@ -128,6 +138,7 @@ private:
     std::string address_, label_;
     int width_ = 0, height_ = 0;
     size_t payload_ = 0;
+    int64_t socketBufferBytes_ = 0, socketBufferLimitBytes_ = 0, packetSize_ = 0;
     bool buffersQueued_ = false;
     std::atomic<bool> acquiring_{false};
 };

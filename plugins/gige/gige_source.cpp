@@ -147,8 +147,14 @@ public:
                 .help("a camera that delivers no image this long while it should (free_run, or a software trigger) is lost"),
             Param::boolean("reconnect", true).help("reopen a lost camera in the background when it answers again"),
             Param::integer("retry_interval_ms", "1000").min(10).unit("ms").help("pause between reconnection attempts"),
-            Param::integer("buffers", "8").min(2).max(256).help("stream buffers per camera"),
-            Param::integer("packet_size", "0").min(0).unit("bytes").help("GigE Vision stream packet size; 0 = keep the camera's"),
+            Param::integer("buffers", "16").min(2).max(256).help("stream buffers per camera"),
+            Param::integer("packet_size", "0").min(0).unit("bytes")
+                .help("GigE Vision stream packet size; 0 = the largest the path carries (Aravis's test packets)"),
+            Param::integer("packet_delay_ns", "0").min(0).unit("ns")
+                .help("pause between two stream packets (GevSCPD), for links that drop bursts; 0 = none"),
+            Param::integer("socket_buffer_bytes", "0").min(0).unit("bytes")
+                .help("receive buffer of each stream socket; 0 = room for every stream buffer's image, at most net.core.rmem_max"),
+            Param::boolean("packet_resend", true).help("ask the camera to send missing packets again (GigE Vision resend)"),
             Param::boolean("packet_socket", false)
                 .help("receive with Aravis's packet socket (less CPU; a camera reopened while others stream may lose frames)"),
             Param::path("calibration", "").help("OpenCV FileStorage YAML calibration published by the source; empty: none"),
@@ -172,7 +178,8 @@ public:
 
         CameraSettings base;
         base.format = format;
-        auto given = [&](const char *key) { return p.isExplicit(key) || p.real(key) > 0; };
+        // 0 keeps the camera's value (or, for packet_size, lets Aravis choose), set or not.
+        auto given = [&](const char *key) { return p.real(key) > 0; };
         if (given("width")) base.width = p.integer("width");
         if (given("height")) base.height = p.integer("height");
         if (given("exposure_us")) base.exposure_us = p.real("exposure_us");
@@ -183,6 +190,9 @@ public:
         base.trigger_line = p.string("trigger_line");
         base.buffers = static_cast<int>(p.integer("buffers"));
         base.packet_socket = p.boolean("packet_socket");
+        base.packet_resend = p.boolean("packet_resend");
+        if (given("packet_delay_ns")) base.packet_delay_ns = p.integer("packet_delay_ns");
+        base.socket_buffer_bytes = p.integer("socket_buffer_bytes");
 
         std::vector<CameraSettings> wanted;
         if (sideBySide_) {
@@ -228,6 +238,7 @@ public:
         }
         width_ = first.width();
         height_ = first.height();
+        for (const auto &slot : slots_) warnTransport(*slot->camera);
         if (trigger_ == "software")
             for (auto &slot : slots_) slot->trigger = std::make_unique<TriggerWorker>(slot->camera);
     }
@@ -263,7 +274,7 @@ public:
     void stop() override {
         running_ = false;
         for (auto &slot : slots_) {
-            dropPending(*slot, false);
+            dropPending(*slot, true); // every image received is accounted for: paired or unpaired
             if (slot->camera) slot->camera->stop();
             slot->awaitingSince.reset();
         }
@@ -319,11 +330,18 @@ public:
             s << "    device: \"" << slot->settings.id << "\"\n";
             s << "    connected: " << (slot->camera ? "true" : "false") << "\n";
             s << "    images: " << slot->images << "\n";
+            s << "    unpaired: " << slot->unpaired << "\n";
+            s << "    incomplete_images: " << incompleteImages(*slot) << "\n";
+            s << "    skipped_frame_ids: " << skippedIds(*slot) << "\n";
             s << "    completed_buffers: " << c.completed << "\n";
             s << "    failed_buffers: " << c.failed << "\n";
             s << "    underrun_buffers: " << c.underruns << "\n";
             s << "    missing_packets: " << c.missing_packets << "\n";
             s << "    resent_packets: " << c.resent_packets << "\n";
+            if (slot->camera) {
+                s << "    packet_size: " << slot->camera->packetSize() << "\n";
+                s << "    socket_buffer_bytes: " << slot->camera->socketBufferBytes() << "\n";
+            }
             s << "    buffers_lent: " << (slot->camera ? slot->camera->home()->lent() : 0) << "\n";
             s << "    losses: " << slot->losses << "\n";
             if (!slot->failures.empty()) {
@@ -376,11 +394,21 @@ private:
         int attempts = 0;                               // reconnection attempts (mutex_)
         std::string lastAttemptError;                   // (mutex_)
         StreamCounters retired;                         // counters of closed streams
-        uint64_t images = 0, losses = 0;
+        uint64_t images = 0, losses = 0, unpaired = 0, idGap = 0;
+        std::optional<uint64_t> lastFrameId; // of the current camera
         std::map<std::string, uint64_t> failures;
         std::unique_ptr<TriggerWorker> trigger; // software trigger: of the current camera
         bool answered = false;                  // software trigger: an image came for the last one
     };
+
+    // The kernel silently caps a socket's receive buffer at net.core.rmem_max.
+    void warnTransport(const Camera &c) const {
+        if (c.socketBufferLimitBytes() > 0 && c.socketBufferBytes() > c.socketBufferLimitBytes())
+            host_.warning("gige: camera " + c.label() + ": stream socket buffer of " + std::to_string(c.socketBufferBytes()) +
+                          " bytes asked, the kernel grants at most net.core.rmem_max = " + std::to_string(c.socketBufferLimitBytes()) +
+                          " bytes; if images lose packets, raise it (sysctl -w net.core.rmem_max=" +
+                          std::to_string(c.socketBufferBytes()) + ")");
+    }
 
     static std::string sizeText(const Camera &c) {
         return std::to_string(c.width()) + "x" + std::to_string(c.height()) + " " + c.format().name;
@@ -396,10 +424,42 @@ private:
         return false;
     }
 
+    void noteUnpaired(Slot &slot) {
+        ++unpaired_;
+        ++slot.unpaired;
+    }
+
+    // Frame ids between two complete images, not counted otherwise: the camera numbered
+    // them but they never left the stream (every packet lost, or no free buffer). Only
+    // complete images' ids are trusted: a buffer that lost packets may carry any id.
+    // GVSP 1.x ids run 1..65535, then wrap.
+    static void countIdGap(Slot &slot, uint64_t id) {
+        if (id == 0) return;
+        if (slot.lastFrameId) {
+            const uint64_t last = *slot.lastFrameId;
+            if (id > last) slot.idGap += id - last - 1;
+            else if (last - id > 32768 && last <= 65535) slot.idGap += (65535 - last) + (id - 1);
+            else return; // an older image given up late, or a repeat: nothing skipped, `last` stays
+        }
+        slot.lastFrameId = id;
+    }
+
+    static uint64_t incompleteImages(const Slot &slot) {
+        uint64_t n = 0;
+        for (const auto &[name, count] : slot.failures) n += count;
+        return n;
+    }
+
+    // Ids skipped between complete images, less the incomplete images among them.
+    static uint64_t skippedIds(const Slot &slot) {
+        const uint64_t incomplete = incompleteImages(slot);
+        return slot.idGap > incomplete ? slot.idGap - incomplete : 0;
+    }
+
     void dropPending(Slot &slot, bool countUnpaired) {
         for (auto &p : slot.pending) {
             p.home->push(p.buffer);
-            if (countUnpaired) ++unpaired_;
+            if (countUnpaired) noteUnpaired(slot);
         }
         slot.pending.clear();
     }
@@ -490,6 +550,7 @@ private:
             for (auto &slot : slots_) {
                 if (!slot->reconnected) continue;
                 slot->camera = std::move(slot->reconnected);
+                slot->lastFrameId.reset(); // a reopened camera numbers its frames anew
                 if (trigger_ == "software") slot->trigger = std::make_unique<TriggerWorker>(slot->camera);
                 host_.info("gige: camera " + slot->camera->label() + " is back (" + std::to_string(slot->attempts) +
                            " attempt(s)); streaming again");
@@ -549,7 +610,7 @@ private:
                     // Exactly one image per camera answers a trigger: anything more is stale.
                     if (slot.answered) {
                         camera.home()->push(buffer);
-                        if (status == ARV_BUFFER_STATUS_SUCCESS) ++unpaired_;
+                        if (status == ARV_BUFFER_STATUS_SUCCESS) noteUnpaired(slot);
                         continue;
                     }
                     slot.answered = true;
@@ -557,6 +618,7 @@ private:
                 } else if (trigger_ == "free_run") {
                     slot.awaitingSince = now;
                 }
+                if (status == ARV_BUFFER_STATUS_SUCCESS) countIdGap(slot, arv_buffer_get_frame_id(buffer));
                 if (status != ARV_BUFFER_STATUS_SUCCESS) {
                     ++slot.failures[statusName(status)];
                     camera.home()->push(buffer);
@@ -580,7 +642,7 @@ private:
                 while (slot.pending.size() > keep) {
                     slot.pending.front().home->push(slot.pending.front().buffer);
                     slot.pending.pop_front();
-                    ++unpaired_;
+                    noteUnpaired(slot);
                 }
             }
         }
@@ -629,7 +691,7 @@ private:
             Slot &older = dt < 0 ? l : r;
             older.pending.front().home->push(older.pending.front().buffer);
             older.pending.pop_front();
-            ++unpaired_;
+            noteUnpaired(older);
         }
         return nullptr;
     }

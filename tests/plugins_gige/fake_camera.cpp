@@ -3,11 +3,23 @@
 // loopback address. Only for use inside a private network namespace (scripts/netns-test.sh).
 #include "fake_camera.hpp"
 
+#include <fcntl.h>
 #include <net/if.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
+#include <thread>
+#include <vector>
+
+extern char **environ;
 
 namespace binocle::test {
 
@@ -81,6 +93,71 @@ void FakeCamera::fill(ArvBuffer *buffer, void *data, guint32, guint32, ArvPixelF
         }
     }
     ++state->sent;
+}
+
+namespace {
+
+// True when a UDP socket is bound to ADDRESS:3956 (GVCP) in this namespace: the camera answers.
+bool gvcpPortOpen(const std::string &address) {
+    unsigned a = 0, b = 0, c = 0, d = 0;
+    if (std::sscanf(address.c_str(), "%u.%u.%u.%u", &a, &b, &c, &d) != 4) return false;
+    char wanted[32];
+    std::snprintf(wanted, sizeof wanted, "%02X%02X%02X%02X:0F74", d, c, b, a); // little-endian, port 3956
+    std::ifstream udp("/proc/net/udp");
+    for (std::string line; std::getline(udp, line);)
+        if (line.find(wanted) != std::string::npos) return true;
+    return false;
+}
+
+} // namespace
+
+ExternalFakeCamera::ExternalFakeCamera(std::string address, std::string serial)
+    : address_(std::move(address)), serial_(std::move(serial)) {}
+
+ExternalFakeCamera::~ExternalFakeCamera() { kill(); }
+
+bool ExternalFakeCamera::start(std::string *why) {
+    if (pid_ > 0) return true;
+    const std::string program = ExternalFakeCamera::program();
+    std::vector<std::string> args = {program, "-i", address_, "-s", serial_};
+    std::vector<char *> argv;
+    for (auto &a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+    pid_t pid = -1;
+    const int rc = posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+        if (why) *why = program + " cannot be started: " + std::strerror(rc) + " (Debian: aravis-tools)";
+        return false;
+    }
+    pid_ = pid;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (!gvcpPortOpen(address_)) {
+        int status = 0;
+        if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+            pid_ = -1;
+            if (why) *why = program + " -i " + address_ + " exited at once (status " + std::to_string(status) + ")";
+            return false;
+        }
+        if (std::chrono::steady_clock::now() > until) {
+            kill();
+            if (why) *why = program + " -i " + address_ + " did not open its GVCP port within 5 s";
+            return false;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return true;
+}
+
+void ExternalFakeCamera::kill() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGKILL); // as a camera that loses power: no goodbye
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
 }
 
 bool networkIsIsolated(std::string *interfaces) {

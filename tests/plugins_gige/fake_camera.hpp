@@ -52,6 +52,30 @@ private:
     ArvGvFakeCamera *camera_ = nullptr;
 };
 
+// Aravis's fake camera as a process of its own (`arv-fake-gv-camera-0.8 -i ADDRESS -s
+// SERIAL`), as a real camera is: its packets cross the kernel's loopback between two
+// processes. kill() ends the process (a camera unplugged), start() starts it again.
+class ExternalFakeCamera {
+public:
+    ExternalFakeCamera(std::string address, std::string serial);
+    ~ExternalFakeCamera();
+    ExternalFakeCamera(const ExternalFakeCamera &) = delete;
+    ExternalFakeCamera &operator=(const ExternalFakeCamera &) = delete;
+
+    // False when the program is not installed or the camera did not answer within 5 s;
+    // `why` says which.
+    bool start(std::string *why = nullptr);
+    void kill();
+    bool alive() const { return pid_ > 0; }
+    const std::string &address() const { return address_; }
+
+    static const char *program() { return "arv-fake-gv-camera-0.8"; }
+
+private:
+    std::string address_, serial_;
+    int pid_ = -1;
+};
+
 // True when this process sees no network interface but `lo`: the only place where the
 // tests may run Aravis (its discovery broadcasts on every interface).
 bool networkIsIsolated(std::string *interfaces = nullptr);

@@ -9,6 +9,7 @@
 #include "pipeline/recorder.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -161,6 +162,34 @@ TEST(Record, FramesAndSetOptionsAndTheRigsCalibration) {
     EXPECT_EQ(replayOf(dir.str("rec"), "bgr").size(), 5u);
 }
 
+TEST(Record, SummarySaysWhatWasTakenWrittenAndLostAndCompressionIsSettable) {
+    TempDir dir;
+    writeColourPairs(dir, 3);
+    binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir, "  loop: true\n"));
+    for (int level : {0, 9}) {
+        const std::string out = dir.str("rec" + std::to_string(level));
+        const auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + out + " --frames 6 --png-compression " +
+                                             std::to_string(level) + " --writer-threads 3 --quiet");
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        // A file source is never dropped from: the writers make it wait.
+        EXPECT_NE(r.output.find("6 pair(s) taken from the source, 0 dropped because the writers were behind (wait when behind)"),
+                  std::string::npos)
+            << r.output;
+        const auto summary = nlohmann::ordered_json::parse(readFile(out + "/summary.json"));
+        EXPECT_EQ(summary["status"], "complete");
+        EXPECT_EQ(summary["pairs_taken"], 6);
+        EXPECT_EQ(summary["pairs_written"], 6);
+        EXPECT_EQ(summary["lost"]["pairs_dropped_by_writer"], 0);
+        EXPECT_EQ(summary["lost"]["when_writers_behind"], "wait");
+        EXPECT_EQ(summary["writer"]["threads"], 3);
+        EXPECT_EQ(summary["writer"]["png_compression"], level);
+        EXPECT_EQ(replayOf(out, "bgr").size(), 6u);
+    }
+    const auto bad = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("bad") + " --png-compression 12");
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.output.find("--png-compression = 12: expected a zlib level 0..9"), std::string::npos) << bad.output;
+}
+
 TEST(Record, RefusesAFolderThatHoldsAnythingAndLosesNothing) {
     TempDir dir;
     writeColourPairs(dir, 2);
@@ -288,6 +317,67 @@ TEST(Record, KilledRecorderLeavesARecordingReadableToItsLastFrame) {
                   << " frame(s) in frames.csv, " << replayed.size() << " replayed bit for bit (" << images << " images, "
                   << leftovers << " temporary file(s) of the frame being written)\n";
     }
+}
+
+TEST(RecordingWriter, AFullQueueRefusesWithoutWaitingAndRowsKeepTheirOrder) {
+    TempDir dir;
+    binocle::RecordingWriterOptions options;
+    options.threads = 1;
+    options.queue_frames = 2;
+    options.sync_batch_frames = 4;
+    std::vector<uint64_t> accepted;
+    {
+        binocle::RecordingWriter w(dir.str("rec"), "", "", options);
+        cv::Mat noise(480, 640, CV_8UC1);
+        for (uint64_t i = 0; i < 40; ++i) {
+            cv::randu(noise, 0, 256);
+            if (w.submit(i, static_cast<int64_t>(i), static_cast<int64_t>(i), noise.clone(), noise.clone(), false, false))
+                accepted.push_back(i);
+        }
+        w.finish();
+        EXPECT_EQ(w.frameCount(), static_cast<int64_t>(accepted.size()));
+        EXPECT_LE(w.stats().max_queued, 2);
+        EXPECT_GE(w.stats().syncs, 1);
+    }
+    // One writer thread cannot encode 640x480 noise as fast as a loop submits it.
+    EXPECT_LT(accepted.size(), 40u);
+    std::ifstream csv(dir.str("rec/frames.csv"));
+    std::string line;
+    std::getline(csv, line);
+    for (uint64_t sequence : accepted) {
+        ASSERT_TRUE(std::getline(csv, line));
+        EXPECT_EQ(line.substr(0, line.find(',')), std::to_string(sequence));
+        EXPECT_TRUE(fs::exists(dir.str("rec/" + binocle::RecordingWriter::imagePath("right", sequence))));
+    }
+    EXPECT_FALSE(std::getline(csv, line)) << "a row for a frame that was refused";
+}
+
+TEST(RecordingWriter, PngCompressionLevelIsTheOneAsked) {
+    TempDir dir;
+    cv::Mat ramp(120, 160, CV_8UC1);
+    for (int y = 0; y < ramp.rows; ++y)
+        for (int x = 0; x < ramp.cols; ++x) ramp.at<uint8_t>(y, x) = static_cast<uint8_t>(x + y);
+    uintmax_t bytes[2] = {0, 0};
+    for (int level : {0, 9}) {
+        binocle::RecordingWriterOptions options;
+        options.png_compression = level;
+        const std::string out = dir.str("rec" + std::to_string(level));
+        binocle::RecordingWriter w(out, "", "", options);
+        w.append(0, 0, 0, ramp, ramp);
+        bytes[level ? 1 : 0] = fs::file_size(out + "/left/000000.png");
+        EXPECT_TRUE(same(cv::imread(out + "/left/000000.png", cv::IMREAD_UNCHANGED), ramp));
+    }
+    EXPECT_GT(bytes[0], 160u * 120u) << "level 0 stores the pixels";
+    EXPECT_LT(bytes[1] * 4, bytes[0]) << "level 9 compresses a ramp";
+    binocle::RecordingWriterOptions bad;
+    bad.png_compression = 10;
+    try {
+        binocle::RecordingWriter w(dir.str("bad"), "", "", bad);
+        ADD_FAILURE() << "level 10 accepted";
+    } catch (const binocle::Error &e) {
+        EXPECT_NE(std::string(e.what()).find("PNG compression level = 10: expected 0..9"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir.str("bad"))) << "nothing created for a refused level";
 }
 
 TEST(RecordingWriter, WritesTheLayoutReplayReads) {
