@@ -120,7 +120,7 @@ struct Reader {
 // is missing (the rig's own validation says so, with its position).
 std::vector<binocle_param_desc> settingsOf(const YAML::Node &block, int32_t kind, const PluginHost &host) {
     if (!block.IsMap() || !block["plugin"] || !block["plugin"].IsScalar()) return {};
-    const PluginRecord *p = host.find(block["plugin"].Scalar(), kind);
+    const PluginRecord *p = host.lookup(block["plugin"].Scalar(), kind);
     return p ? p->params() : std::vector<binocle_param_desc>{};
 }
 
