@@ -8,6 +8,7 @@
 #include "core/image_io.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -23,23 +24,81 @@ Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
     source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
     matcher_ = std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params);
     for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
-    for (const auto &e : rig.evaluators) {
-        auto slot = std::make_unique<EvaluatorSlot>();
-        slot->name = e.plugin;
-        EvaluatorSlot *raw = slot.get();
-        HostSink sink;
-        sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
-            if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
-            if (!raw->target) return;
-            raw->target->set(name, value);
-            if (!unit.empty()) raw->target->set(name + "_unit", unit);
-        };
-        sink.text = [raw](const std::string &name, const std::string &text) {
-            if (raw->target) raw->target->set(name, text);
-        };
-        slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
-        evaluators_.push_back(std::move(slot));
+    for (const auto &e : rig.evaluators) evaluators_.push_back(makeEvaluator(e));
+}
+
+std::unique_ptr<Pipeline::EvaluatorSlot> Pipeline::makeEvaluator(const PluginBlock &e) {
+    auto slot = std::make_unique<EvaluatorSlot>();
+    slot->name = e.plugin;
+    EvaluatorSlot *raw = slot.get();
+    HostSink sink;
+    sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
+        if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
+        if (!raw->target) return;
+        raw->target->set(name, value);
+        if (!unit.empty()) raw->target->set(name + "_unit", unit);
+    };
+    sink.text = [raw](const std::string &name, const std::string &text) {
+        if (raw->target) raw->target->set(name, text);
+    };
+    slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
+    return slot;
+}
+
+namespace {
+
+// Same plugin with the same settings: the instance can stay.
+bool sameBlock(const PluginBlock &a, const PluginBlock &b) {
+    if (a.plugin != b.plugin || a.params.size() != b.params.size()) return false;
+    for (int32_t i = 0; i < a.params.size(); ++i) {
+        const binocle_param &x = a.params.data()[i], &y = b.params.data()[i];
+        if (std::string(x.name) != y.name || x.type != y.type || x.i != y.i || x.explicit_ != y.explicit_) return false;
+        if (!(x.d == y.d || (std::isnan(x.d) && std::isnan(y.d)))) return false;
+        if ((x.s == nullptr) != (y.s == nullptr) || (x.s && std::string(x.s) != y.s)) return false;
     }
+    return true;
+}
+
+} // namespace
+
+void Pipeline::reconfigure(const RigConfig &rig) {
+    // Everything new is created first: a refusal throws before anything is replaced.
+    std::unique_ptr<Source> source;
+    std::unique_ptr<Matcher> matcher;
+    std::vector<std::unique_ptr<CloudTransform>> transforms(rig.transforms.size());
+    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators(rig.evaluators.size());
+    const bool newSource = !sameBlock(rig.source, rig_.source) || rig.calibration_file != rig_.calibration_file;
+    if (newSource) source = std::make_unique<Source>(*rig.source.record, rig.source.params);
+    if (!sameBlock(rig.matcher, rig_.matcher)) matcher = std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params);
+    for (size_t i = 0; i < rig.transforms.size(); ++i)
+        if (i >= rig_.transforms.size() || !sameBlock(rig.transforms[i], rig_.transforms[i]))
+            transforms[i] = std::make_unique<CloudTransform>(*rig.transforms[i].record, rig.transforms[i].params);
+    for (size_t i = 0; i < rig.evaluators.size(); ++i)
+        if (i >= rig_.evaluators.size() || !sameBlock(rig.evaluators[i], rig_.evaluators[i]))
+            evaluators[i] = makeEvaluator(rig.evaluators[i]);
+    if (source && sourceStarted_) {
+        // A camera is held by one instance at a time: the old one lets go first, and
+        // takes the device back when the new one cannot start.
+        source_->stop();
+        try {
+            source->start();
+        } catch (...) {
+            source_->start();
+            throw;
+        }
+    }
+    if (source) {
+        source_ = std::move(source);
+        calibrationReady_ = false; // another source may publish another calibration
+    }
+    if (matcher) matcher_ = std::move(matcher);
+    for (size_t i = 0; i < transforms.size(); ++i)
+        if (!transforms[i]) transforms[i] = std::move(transforms_[i]);
+    transforms_ = std::move(transforms);
+    for (size_t i = 0; i < evaluators.size(); ++i)
+        if (!evaluators[i]) evaluators[i] = std::move(evaluators_[i]);
+    evaluators_ = std::move(evaluators);
+    rig_ = rig;
 }
 
 Pipeline::~Pipeline() = default;
@@ -77,6 +136,12 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
 FrameResult Pipeline::process(const LentFrame &frame) {
     const auto t0 = std::chrono::steady_clock::now();
     FrameResult r;
+    auto mark = t0;
+    auto stage = [&](const char *name) {
+        const auto now = std::chrono::steady_clock::now();
+        r.stage_seconds.emplace_back(name, std::chrono::duration<double>(now - mark).count());
+        mark = now;
+    };
     r.sequence = frame.raw().sequence;
     cv::Mat left = frame.left(), right = frame.right();
     if (!calibrationReady_) prepareCalibration(left.size());
@@ -87,14 +152,18 @@ FrameResult Pipeline::process(const LentFrame &frame) {
         cv::remap(left, r.rectified_left, map1x_, map1y_, cv::INTER_LINEAR);
         cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
     }
+    stage("rectify");
     r.disparity = matcher_->compute(r.rectified_left, r.rectified_right);
     r.valid_pixel_ratio = static_cast<double>(cv::countNonZero(r.disparity > 0)) / static_cast<double>(r.disparity.total());
+    stage("match");
     r.cloud = cloudFromDisparity(r.disparity, calibration_, r.rectified_left, rig_.outputs.max_range_mm);
+    stage("cloud");
     for (auto &t : transforms_) {
         binocle_cloud view = r.cloud.view();
         t->apply(view);
         r.cloud.adopt(view);
     }
+    stage("transforms");
     r.metrics = Json::object();
     if (!evaluators_.empty()) {
         binocle_image rl{}, rr{}, d{};
@@ -135,15 +204,15 @@ FrameResult Pipeline::process(const LentFrame &frame) {
             r.metrics.set(slot->name, std::move(figures));
         }
     }
+    stage("evaluators");
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
 }
 
-void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const {
+void writeFrameOutputs(const FrameResult &r, const OutputOptions &o, const std::string &dir) {
     char stem[32];
     std::snprintf(stem, sizeof stem, "%06llu", static_cast<unsigned long long>(r.sequence));
     const fs::path d(dir);
-    const auto &o = rig_.outputs;
     if (o.disparity_png) writeDisparityPng16((d / ("disparity_" + std::string(stem) + ".png")).string(), r.disparity);
     if (o.disparity_color) writeImage((d / ("disparity_color_" + std::string(stem) + ".png")).string(), colorizeDisparity(r.disparity));
     if (o.disparity_pfm) writePfm((d / ("disparity_" + std::string(stem) + ".pfm")).string(), r.disparity);
@@ -210,12 +279,14 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     };
     try {
         source_->start();
+        sourceStarted_ = true;
         Progress progress(options.progress, options.max_frames);
         while (options.max_frames < 0 || count < options.max_frames) {
+            if (options.between_frames && !options.between_frames()) break;
             std::unique_ptr<LentFrame> frame = source_->grab(options.grab_timeout_ms);
             if (!frame) break;
             FrameResult r = process(*frame);
-            if (!outDir_.empty()) writeOutputs(r, outDir_);
+            if (!outDir_.empty()) writeFrameOutputs(r, rig_.outputs, outDir_);
             Json f = Json::object();
             f.set("sequence", r.sequence);
             f.set("valid_pixel_ratio", r.valid_pixel_ratio);

@@ -21,6 +21,9 @@ struct RunOptions {
     std::string out_dir;       // empty: write nothing
     bool progress = true;      // a progress line on stderr
     int32_t grab_timeout_ms = 5000;
+    // Called on the pipeline's thread before each grab, between frames: the one place
+    // where reconfigure() may run. Returning false ends the run as if the source ended.
+    std::function<bool()> between_frames;
 };
 
 // What one frame produced, for callers that want more than files (experiments, tests).
@@ -33,7 +36,13 @@ struct FrameResult {
     Json metrics;      // {evaluator: {metric: value}}
     std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
     double seconds = 0;
+    // Time of each step, in order: rectify, match, cloud, transforms, evaluators.
+    std::vector<std::pair<std::string, double>> stage_seconds;
 };
+
+// Writes what `outputs` asks for of one frame into `dir` (disparity PNG/PFM, colourised
+// disparity, rectified images, cloud PLY), each file atomically; names carry the sequence.
+void writeFrameOutputs(const FrameResult &r, const OutputOptions &outputs, const std::string &dir);
 
 class Pipeline {
 public:
@@ -44,13 +53,23 @@ public:
     // `onFrame` sees every frame's result before it is dropped.
     Json run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame = {});
 
+    // Takes a changed rig between frames (from RunOptions::between_frames): the matcher,
+    // transforms, evaluators and source whose block changed are created anew, all before
+    // any is swapped in, so a plugin that refuses its settings leaves the pipeline as it
+    // was (the PluginError propagates). A new source is started when the old one was.
+    void reconfigure(const RigConfig &rig);
+    // The matcher's own answer (plugin API), not the rig's value.
+    std::pair<int32_t, int32_t> matcherDisparityRange() { return matcher_->disparityRange(); }
+    const RigConfig &rig() const { return rig_; }
+
     const StereoCalibration &calibration() const { return calibration_; }
     Source &source() { return *source_; }
 
 private:
+    struct EvaluatorSlot;
     void prepareCalibration(const cv::Size &imageSize);
     FrameResult process(const LentFrame &frame);
-    void writeOutputs(const FrameResult &r, const std::string &dir) const;
+    std::unique_ptr<EvaluatorSlot> makeEvaluator(const PluginBlock &block);
 
     RigConfig rig_;
     std::unique_ptr<Source> source_;
@@ -63,6 +82,7 @@ private:
         std::vector<std::pair<std::string, double>> *flat = nullptr;
     };
     std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
+    bool sourceStarted_ = false;
     StereoCalibration calibration_;
     std::string calibrationYaml_;
     bool calibrationReady_ = false;
