@@ -3,6 +3,7 @@
 #include "cli/command.hpp"
 #include "core/error.hpp"
 #include "experiment/experiment.hpp"
+#include "report/html_report.hpp"
 
 #include <iostream>
 #include <sstream>
@@ -33,11 +34,12 @@ int run(const Args &args) {
     std::cerr << "experiment " << e.name << ": " << result.get("tests")->number() << " test(s) in "
               << static_cast<int>(result.get("seconds")->number()) << " s, " << failed << " failed; results in "
               << options.out_dir << " (results.csv, results.json, charts, test_<id>/)\n";
+    if (args.has("--report")) std::cerr << "report: " << report::writeExperimentReport(options.out_dir) << "\n";
     return failed ? 1 : 0;
 }
 
 Register reg({"experiment", "run an experiment (E1, E2 of METHOD.md): a table of errors and efficiencies, charts",
-              "usage: binocle experiment FILE [--out DIR] [--tests ID,ID...] [--check] [--quiet]\n\n"
+              "usage: binocle experiment FILE [--out DIR] [--tests ID,ID...] [--check] [--report] [--quiet]\n\n"
               "Runs each test of the experiment file: the base rig with the test's baseline,\n"
               "focal length, range, camera height and inclination. The whole file, and the rig\n"
               "of every test, is validated before anything runs. Writes into DIR (default\n"
@@ -50,8 +52,9 @@ Register reg({"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
               "  --out DIR        output folder\n"
               "  --tests 1,5,9    run only these tests\n"
               "  --check          validate the file and stop\n"
+              "  --report         also write DIR/report.html (as `binocle report DIR`)\n"
               "  --quiet          no progress bar\n",
-              {"--check", "--quiet"},
+              {"--check", "--quiet", "--report"},
               run});
 
 } // namespace

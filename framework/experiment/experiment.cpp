@@ -117,6 +117,12 @@ void checkGeometry(const Experiment &e, const ExperimentTest &t, const Reader &r
                          " .. " + num(e.baseline_max_mm) + " mm");
 }
 
+std::string yamlBlock(const YAML::Node &n) {
+    YAML::Emitter em;
+    em << n;
+    return em.c_str();
+}
+
 std::string yamlText(const YAML::Node &n) {
     YAML::Emitter em;
     em << YAML::Flow << n;
@@ -372,7 +378,15 @@ std::string testLabel(const ExperimentTest &t) {
     return os.str() + ")";
 }
 
-void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows) {
+// What produced the results, for the report: binocle's and each plugin's version.
+Json software(const PluginHost &host) {
+    Json plugins = Json::array();
+    for (const auto &p : host.plugins())
+        plugins.push(Json::object().set("name", p.name).set("version", p.version).set("kind", kindName(p.kind)));
+    return Json::object().set("binocle", BINOCLE_VERSION).set("opencv", CV_VERSION).set("plugins", std::move(plugins));
+}
+
+void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows, const PluginHost &host) {
     std::vector<std::string> columns;
     for (const auto &r : rows)
         for (const auto &[n, v] : r.values)
@@ -400,8 +414,11 @@ void writeTables(const std::string &dir, const Experiment &e, const std::vector<
     writeFileAtomic((fs::path(dir) / "results.csv").string(), csv);
     Json doc = Json::object();
     doc.set("experiment", e.name);
+    doc.set("description", e.description);
     doc.set("file", e.file);
     doc.set("rig", e.rig_file);
+    doc.set("rig_yaml", yamlBlock(e.rig));
+    doc.set("software", software(host));
     doc.set("units", Json::object().set("length", "mm").set("angle", "deg").set("errors_and_efficiencies", "%"));
     doc.set("tests", std::move(tests));
     writeFileAtomic((fs::path(dir) / "results.json").string(), doc.dump());
@@ -568,7 +585,7 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
         row.put("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         rows.push_back(std::move(row));
         // Rewritten after every test: an interrupted experiment keeps what it measured.
-        writeTables(options.out_dir, e, rows);
+        writeTables(options.out_dir, e, rows, host);
     }
     bar.show(selected.size(), "done");
     writeCharts(options.out_dir, e, rows);
