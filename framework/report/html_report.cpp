@@ -94,14 +94,18 @@ const std::vector<Column> kMainColumns = {
     {"epsilon_y_percent", "εy", "%", 1},    {"epsilon_z_percent", "εz", "%", 1},  {"eta_2d_percent", "η2D", "%", 1},
     {"eta_3d_percent", "η3D", "%", 1},      {"valid_pixel_ratio", "valid px", "", 3}, {"seconds", "time", "s", 2}};
 
-// What the paper reported, per test id and figure: results.json's `paper.<figure>`
-// columns when the run recorded them, else the experiment file's `paper:` blocks.
+// What the paper reported, per test id and figure: results.json's `details.paper`
+// ({figure: {reported, difference}}) when the run recorded it, else the experiment
+// file's `paper:` blocks. (Columns named "paper.<figure>" are the `paper` evaluator's
+// own figures, not the paper's.)
 std::map<std::string, std::map<std::string, double>> paperValues(const OJson &results) {
     std::map<std::string, std::map<std::string, double>> out;
     for (const auto &row : results["tests"]) {
         const std::string id = row.value("test", std::string());
-        for (const auto &[k, v] : row.items())
-            if (k.rfind("paper.", 0) == 0 && v.is_number()) out[id][k.substr(6)] = v.get<double>();
+        if (!row.contains("details") || !row["details"].contains("paper") || !row["details"]["paper"].is_object()) continue;
+        for (const auto &[k, v] : row["details"]["paper"].items())
+            if (v.is_object() && v.contains("reported") && v["reported"].is_number()) out[id][k] = v["reported"].get<double>();
+            else if (v.is_number()) out[id][k] = v.get<double>();
     }
     if (!out.empty()) return out;
     const std::string file = results.value("file", std::string());

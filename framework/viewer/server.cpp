@@ -377,7 +377,7 @@ bool Server::isLocalHost(const std::string &host, const std::string &boundAddres
         const std::string rest = name.substr(close + 1);
         if (!rest.empty() && (rest[0] != ':' || rest.find_first_not_of("0123456789", 1) != std::string::npos)) return false;
         name = name.substr(1, close - 1);
-    } else if (const size_t colon = name.find(':'); colon != std::string::npos) {
+    } else if (const size_t colon = name.find(':'); colon != std::string::npos && name.find(':', colon + 1) == std::string::npos) {
         if (name.find_first_not_of("0123456789", colon + 1) != std::string::npos) return false;
         name = name.substr(0, colon);
     }

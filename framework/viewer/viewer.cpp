@@ -198,11 +198,25 @@ private:
             recent_.push_back(now);
             while (recent_.size() > 2 && now - recent_.front() > std::chrono::seconds(2)) recent_.pop_front();
         }
-        // The display takes a frame only when someone can look at it; otherwise this
-        // callback costs a few comparisons.
-        if (!server_->wantsFrame() || encoderBusy_ || now - lastHandOver_ < minInterval_) return;
-        std::unique_lock<std::mutex> slot(slotMutex_, std::try_to_lock);
-        if (!slot.owns_lock() || slot_) return;
+        bool stepped = false;
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            stepped = paused_;
+        }
+        std::unique_lock<std::mutex> slot(slotMutex_, std::defer_lock);
+        if (stepped) {
+            // A frame made by `step`: the user waits for exactly this one, and the
+            // pipeline is paused anyway, so it waits for the encoder rather than skip.
+            if (server_->browsers() == 0) return;
+            slot.lock();
+            slotCv_.wait(slot, [&] { return (!slot_ && !encoderBusy_) || encoderQuit_; });
+        } else {
+            // The display takes a frame only when someone can look at it; otherwise this
+            // callback costs a few comparisons.
+            if (!server_->wantsFrame() || encoderBusy_ || now - lastHandOver_ < minInterval_) return;
+            slot.try_lock();
+            if (!slot.owns_lock() || slot_) return;
+        }
         auto p = std::make_shared<FrameProducts>(copyFrame(r));
         {
             std::lock_guard<std::mutex> lock(mutex_);
@@ -218,7 +232,7 @@ private:
         encoderBusy_ = true;
         lastHandOver_ = now;
         slot.unlock();
-        slotCv_.notify_one();
+        slotCv_.notify_all();
     }
 
     // ---- Encoder thread -------------------------------------------------------------
@@ -226,6 +240,7 @@ private:
         std::unique_lock<std::mutex> lock(slotMutex_);
         for (;;) {
             slotCv_.wait(lock, [&] { return slot_ || encoderQuit_; });
+            // (the pipeline's hand-over waits on the same condition variable)
             if (encoderQuit_) return;
             std::shared_ptr<const FrameProducts> p = std::move(slot_);
             slot_.reset();
@@ -246,8 +261,9 @@ private:
                 std::lock_guard<std::mutex> counters(mutex_);
                 ++sent_;
             }
-            encoderBusy_ = false;
             lock.lock();
+            encoderBusy_ = false;
+            slotCv_.notify_all(); // a stepped frame may be waiting for the encoder
         }
     }
 
