@@ -5,6 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir="${BINOCLE_BUILD_DIR:-build}"
+# ccache: paths inside the checkout are hashed relative to it, so that clones in other
+# folders (CI's fresh clone) share the cache.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
 if [ ! -f "$build_dir/build.ninja" ]; then
   launcher=()
   if command -v ccache >/dev/null 2>&1; then

@@ -77,7 +77,7 @@ CalibrationFiles CalibrationFiles::beside(const std::string &calibrationPath) {
 void writeCalibrationFiles(const CalibrationFiles &files, const StereoCalibration &c, const Json &report) {
     // Everything is formatted before the first byte is written.
     const std::string left = cameraInfoYaml(c, false, "left"), right = cameraInfoYaml(c, true, "right");
-    const std::string json = report.dump() + "\n";
+    const std::string json = dumpJson(report);
     const fs::path dir = fs::path(files.calibration).parent_path();
     if (!dir.empty()) {
         std::error_code ec;

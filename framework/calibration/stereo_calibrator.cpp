@@ -189,54 +189,49 @@ CalibrationResult StereoCalibrator::calibrate() const {
 Json calibrationReport(const CalibrationResult &r, const CalibrationOptions &o, double pixelPitchUm) {
     const StereoCalibration &c = r.calibration;
     Json report = Json::object();
-    report.set("configuration", c.configuration);
-    report.set("units", Json::object().set("length", "mm").set("error", "px (RMS reprojection error)"));
-    report.set("board", Json::object()
-                            .set("cols", o.board.cols)
-                            .set("rows", o.board.rows)
-                            .set("square_mm", o.board.square_mm));
-    report.set("image_width", c.image_size.width);
-    report.set("image_height", c.image_size.height);
-    report.set("pairs_offered", static_cast<int>(r.pairs.size()));
-    report.set("pairs_used", r.usedPairs());
-    report.set("rounds", r.rounds);
-    report.set("rms_px", r.rms_px);
-    report.set("rms_left_px", r.rms_left_px);
-    report.set("rms_right_px", r.rms_right_px);
-    report.set("baseline_mm", c.baselineMm());
-    report.set("T_mm", Json::array().push(c.T.at<double>(0)).push(c.T.at<double>(1)).push(c.T.at<double>(2)));
-    Json focal = Json::object();
-    focal.set("left_fx", c.M1.at<double>(0, 0)).set("left_fy", c.M1.at<double>(1, 1));
-    focal.set("right_fx", c.M2.at<double>(0, 0)).set("right_fy", c.M2.at<double>(1, 1));
-    focal.set("rectified", c.focalLengthPx());
-    report.set("focal_length_px", focal);
+    report["configuration"] = c.configuration;
+    report["units"] = {{"length", "mm"}, {"error", "px (RMS reprojection error)"}};
+    report["board"] = {{"cols", o.board.cols}, {"rows", o.board.rows}, {"square_mm", o.board.square_mm}};
+    report["image_width"] = c.image_size.width;
+    report["image_height"] = c.image_size.height;
+    report["pairs_offered"] = r.pairs.size();
+    report["pairs_used"] = r.usedPairs();
+    report["rounds"] = r.rounds;
+    report["rms_px"] = r.rms_px;
+    report["rms_left_px"] = r.rms_left_px;
+    report["rms_right_px"] = r.rms_right_px;
+    report["baseline_mm"] = c.baselineMm();
+    report["T_mm"] = {c.T.at<double>(0), c.T.at<double>(1), c.T.at<double>(2)};
+    report["focal_length_px"] = {{"left_fx", c.M1.at<double>(0, 0)},  {"left_fy", c.M1.at<double>(1, 1)},
+                                 {"right_fx", c.M2.at<double>(0, 0)}, {"right_fy", c.M2.at<double>(1, 1)},
+                                 {"rectified", c.focalLengthPx()}};
     if (pixelPitchUm > 0) {
         const double mmPerPx = pixelPitchUm / 1000.0;
-        report.set("pixel_pitch_um", pixelPitchUm);
-        report.set("focal_length_mm", Json::object()
-                                          .set("left", c.M1.at<double>(0, 0) * mmPerPx)
-                                          .set("right", c.M2.at<double>(0, 0) * mmPerPx)
-                                          .set("rectified", c.focalLengthPx() * mmPerPx));
+        report["pixel_pitch_um"] = pixelPitchUm;
+        report["focal_length_mm"] = {{"left", c.M1.at<double>(0, 0) * mmPerPx},
+                                     {"right", c.M2.at<double>(0, 0) * mmPerPx},
+                                     {"rectified", c.focalLengthPx() * mmPerPx}};
     }
     Json used = Json::array(), rejected = Json::array();
     for (const auto &p : r.pairs) {
-        Json j = Json::object();
-        j.set("id", p.id);
-        if (!p.left_name.empty()) j.set("left", p.left_name);
-        if (!p.right_name.empty()) j.set("right", p.right_name);
+        Json j = {{"id", p.id}};
+        if (!p.left_name.empty()) j["left"] = p.left_name;
+        if (!p.right_name.empty()) j["right"] = p.right_name;
         if (p.used) {
-            j.set("error_px", p.errorPx()).set("error_left_px", p.error_left_px).set("error_right_px", p.error_right_px);
-            j.set("board_area_percent", std::min(p.left.area_percent, p.right.area_percent));
-            j.set("edge_width_px", std::max(p.left.edge_width_px, p.right.edge_width_px));
-            used.push(std::move(j));
+            j["error_px"] = p.errorPx();
+            j["error_left_px"] = p.error_left_px;
+            j["error_right_px"] = p.error_right_px;
+            j["board_area_percent"] = std::min(p.left.area_percent, p.right.area_percent);
+            j["edge_width_px"] = std::max(p.left.edge_width_px, p.right.edge_width_px);
+            used.push_back(std::move(j));
         } else {
-            j.set("reason", p.rejection);
-            if (p.errorPx() >= 0) j.set("error_px", p.errorPx());
-            rejected.push(std::move(j));
+            j["reason"] = p.rejection;
+            if (p.errorPx() >= 0) j["error_px"] = p.errorPx();
+            rejected.push_back(std::move(j));
         }
     }
-    report.set("pairs", used);
-    report.set("rejected", rejected);
+    report["pairs"] = std::move(used);
+    report["rejected"] = std::move(rejected);
     return report;
 }
 

@@ -10,6 +10,7 @@
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
+#include "core/progress.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -17,9 +18,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <spdlog/spdlog.h>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -39,43 +41,53 @@ std::string pad(std::string s, size_t width) {
 
 std::string baseName(const std::string &path) { return path.empty() ? "" : fs::path(path).filename().string(); }
 
+// The report of the command, line by line, into the log at info level (plain lines).
+void logLines(const std::string &text) {
+    std::stringstream ss(text);
+    for (std::string line; std::getline(ss, line);) spdlog::info("{}", line);
+}
+
 // One line per pair as it is screened.
 void printScreened(const PairRecord &p) {
-    std::cerr << "  pair " << pad(p.id, 6);
+    std::ostringstream os;
+    os << "  pair " << pad(p.id, 6);
     if (!p.rejection.empty()) {
-        std::cerr << "rejected: " << p.rejection << "\n";
-        return;
+        os << "rejected: " << p.rejection << "\n";
+        return logLines(os.str());
     }
-    std::cerr << "board found: " << fixed(std::min(p.left.area_percent, p.right.area_percent), 1) << " % of the image, edges "
+    os << "board found: " << fixed(std::min(p.left.area_percent, p.right.area_percent), 1) << " % of the image, edges "
               << fixed(std::max(p.left.edge_width_px, p.right.edge_width_px), 1) << " px\n";
+    logLines(os.str());
 }
 
 void printSummary(const CalibrationResult &r, double squareMm, double pixelPitchUm) {
-    std::cerr << "\n  " << pad("pair", 8) << pad("left", 16) << pad("right", 16) << pad("error px", 10) << pad("left/right px", 15)
+    std::ostringstream os;
+    os << "\n  " << pad("pair", 8) << pad("left", 16) << pad("right", 16) << pad("error px", 10) << pad("left/right px", 15)
               << "status\n";
     for (const auto &p : r.pairs) {
-        std::cerr << "  " << pad(p.id, 8) << pad(baseName(p.left_name), 16) << pad(baseName(p.right_name), 16);
+        os << "  " << pad(p.id, 8) << pad(baseName(p.left_name), 16) << pad(baseName(p.right_name), 16);
         if (p.used)
-            std::cerr << pad(fixed(p.errorPx(), 3), 10) << pad(fixed(p.error_left_px, 2) + "/" + fixed(p.error_right_px, 2), 15)
+            os << pad(fixed(p.errorPx(), 3), 10) << pad(fixed(p.error_left_px, 2) + "/" + fixed(p.error_right_px, 2), 15)
                       << "used\n";
         else
-            std::cerr << pad(p.errorPx() >= 0 ? fixed(p.errorPx(), 3) : "-", 10) << pad("", 15) << "rejected: " << p.rejection
+            os << pad(p.errorPx() >= 0 ? fixed(p.errorPx(), 3) : "-", 10) << pad("", 15) << "rejected: " << p.rejection
                       << "\n";
     }
     const StereoCalibration &c = r.calibration;
-    std::cerr << "\n  overall RMS reprojection error " << fixed(r.rms_px, 3) << " px over " << r.usedPairs() << " of "
+    os << "\n  overall RMS reprojection error " << fixed(r.rms_px, 3) << " px over " << r.usedPairs() << " of "
               << r.pairs.size() << " pairs (" << r.rounds << " calibration round" << (r.rounds > 1 ? "s" : "")
               << "; single-camera RMS left " << fixed(r.rms_left_px, 3) << ", right " << fixed(r.rms_right_px, 3) << " px)\n";
-    std::cerr << "  baseline |T| " << fixed(c.baselineMm(), 2) << " mm, T = (" << fixed(c.T.at<double>(0), 2) << ", "
+    os << "  baseline |T| " << fixed(c.baselineMm(), 2) << " mm, T = (" << fixed(c.T.at<double>(0), 2) << ", "
               << fixed(c.T.at<double>(1), 2) << ", " << fixed(c.T.at<double>(2), 2) << ") mm  (scales with --square-mm "
               << squareMm << ")\n";
-    std::cerr << "  focal length left " << fixed(c.M1.at<double>(0, 0), 1) << " px, right " << fixed(c.M2.at<double>(0, 0), 1)
+    os << "  focal length left " << fixed(c.M1.at<double>(0, 0), 1) << " px, right " << fixed(c.M2.at<double>(0, 0), 1)
               << " px, rectified " << fixed(c.focalLengthPx(), 1) << " px";
     if (pixelPitchUm > 0)
-        std::cerr << "  = " << fixed(c.M1.at<double>(0, 0) * pixelPitchUm / 1000, 2) << " / "
+        os << "  = " << fixed(c.M1.at<double>(0, 0) * pixelPitchUm / 1000, 2) << " / "
                   << fixed(c.M2.at<double>(0, 0) * pixelPitchUm / 1000, 2) << " / "
                   << fixed(c.focalLengthPx() * pixelPitchUm / 1000, 2) << " mm at " << pixelPitchUm << " um pixels";
-    std::cerr << "\n";
+    os << "\n";
+    logLines(os.str());
 }
 
 // The left and right file names a source reports in its frame metadata (replay does).
@@ -89,62 +101,66 @@ std::pair<std::string, std::string> filesOf(const LentFrame &frame) {
     return {};
 }
 
-int calibrate(const Args &args) {
-    // Every input is checked before anything is read or written.
-    if (args.positional().size() > 1) throw Error("expected at most one rig file: binocle calibrate [RIG.yaml] ... (see --help)");
-    if (!args.has("--board")) throw Error("missing --board COLSxROWS: the chessboard's inner corners per row and column, e.g. 9x6");
-    if (!args.has("--square-mm"))
-        throw Error("missing --square-mm: the side of one chessboard square in mm (the recovered baseline scales with it)");
+struct CalibrateArgs {
+    RigArgs rig;
+    std::string board, pairs, out;
+    std::optional<double> square_mm, pixel_pitch_um;
     CalibrationOptions options;
-    options.board = BoardSpec::parse(args.get("--board"), args.real("--square-mm", 0));
-    options.min_board_area_percent = args.real("--min-board-percent", options.min_board_area_percent);
-    options.max_edge_width_px = args.real("--max-edge-width-px", options.max_edge_width_px);
-    options.max_pair_error_px = args.real("--max-pair-error-px", options.max_pair_error_px);
-    options.min_pairs = static_cast<int>(args.integer("--min-pairs", options.min_pairs));
-    options.fix_intrinsic = args.has("--fix-intrinsic");
-    options.fix_k3 = args.has("--fix-k3");
-    if (options.min_pairs < 3) throw Error("--min-pairs " + std::to_string(options.min_pairs) + ": expected at least 3");
-    if (!(options.max_pair_error_px > 0)) throw Error("--max-pair-error-px: expected a value > 0");
-    const bool live = args.has("--live");
-    const std::string pairsDir = args.get("--pairs");
-    if (live && args.has("--pairs")) throw Error("--pairs and --live exclude each other: pairs come from a folder or from the rig's source");
-    if (args.has("--pairs") && pairsDir.empty()) throw Error("--pairs: expected a folder");
-    if (args.positional().empty() && !args.has("--pairs"))
-        throw Error("expected a rig file (its source delivers the pairs) or --pairs DIR (see --help)");
-    const long long wanted = args.integer("--pairs-wanted", live ? 12 : -1);
-    const long long maxFrames = args.integer("--frames", -1);
-    const long long stillFrames = args.integer("--still-frames", 5);
-    const double stillPx = args.real("--still-px", 1.0);
-    if (args.has("--pairs-wanted") && wanted < options.min_pairs)
-        throw Error("--pairs-wanted " + std::to_string(wanted) + ": expected at least --min-pairs (" +
-                    std::to_string(options.min_pairs) + ")");
-    if (stillFrames < 2) throw Error("--still-frames " + std::to_string(stillFrames) + ": expected at least 2");
+    bool live = false;
+    std::optional<long long> pairs_wanted;
+    long long frames = -1, still_frames = 5;
+    double still_px = 1.0;
+};
+
+int calibrate(const CalibrateArgs &args, const CLI::App &app) {
+    // Every input is checked before anything is read or written.
+    const bool pairsGiven = app.count("--pairs") > 0;
+    CalibrationOptions options = args.options;
+    try {
+        options.board = BoardSpec::parse(args.board, *args.square_mm);
+    } catch (const Error &e) {
+        throw UsageError(e.what());
+    }
+    if (!(options.max_pair_error_px > 0)) throw UsageError("--max-pair-error-px: expected a value > 0");
+    const bool live = args.live;
+    const std::string pairsDir = args.pairs;
+    if (live && pairsGiven) throw UsageError("--pairs and --live exclude each other: pairs come from a folder or from the rig's source");
+    if (pairsGiven && pairsDir.empty()) throw UsageError("--pairs: expected a folder");
+    if (args.rig.file.empty() && !pairsGiven)
+        throw UsageError("expected a rig file (its source delivers the pairs) or --pairs DIR");
+    const long long wanted = args.pairs_wanted.value_or(live ? 12 : -1);
+    const long long maxFrames = args.frames;
+    const long long stillFrames = args.still_frames;
+    const double stillPx = args.still_px;
+    if (args.pairs_wanted && wanted < options.min_pairs)
+        throw UsageError("--pairs-wanted " + std::to_string(wanted) + ": expected at least --min-pairs (" +
+                         std::to_string(options.min_pairs) + ")");
 
     std::optional<RigConfig> rig;
     std::optional<PluginHost> host;
     StatedGeometry stated;
-    if (!args.positional().empty()) {
+    if (!args.rig.file.empty()) {
         host.emplace();
         host->scan();
-        rig = loadRigFromArgs(args, *host);
+        rig = loadRig(args.rig, *host);
         stated = statedGeometry(rig->source);
-    } else if (args.has("--set")) {
-        throw Error("--set changes a rig, but no rig file was given");
+    } else if (!args.rig.overrides.empty()) {
+        throw UsageError("--set changes a rig, but no rig file was given");
     }
-    const double pixelPitchUm = args.real("--pixel-pitch-um", stated.pixel_pitch_um.value_or(0));
-    const std::string out = args.get("--out");
-    if (args.has("--out") && out.empty()) throw Error("--out: expected a file name");
+    const double pixelPitchUm = args.pixel_pitch_um.value_or(stated.pixel_pitch_um.value_or(0));
+    const std::string out = args.out;
+    if (app.count("--out") && out.empty()) throw UsageError("--out: expected a file name");
 
     StereoCalibrator calibrator(options);
     const std::string boardText = std::to_string(options.board.cols) + "x" + std::to_string(options.board.rows);
-    if (args.has("--pairs")) {
+    if (pairsGiven) {
         const PairListing listing = listImagePairs(pairsDir);
-        for (const auto &u : listing.unmatched) std::cerr << "  ignored " << u << "\n";
+        for (const auto &u : listing.unmatched) spdlog::info("  ignored {}", u);
         if (listing.pairs.empty())
             throw Error("--pairs " + pairsDir + ": no image pairs found (expected left<N>.png|jpg with right<N>.png|jpg, e.g. "
                         "left01.jpg and right01.jpg)");
-        std::cerr << "binocle calibrate: " << boardText << " board, " << options.board.square_mm << " mm squares, "
-                  << listing.pairs.size() << " pair(s) in " << pairsDir << "\n";
+        spdlog::info("binocle calibrate: {} board, {} mm squares, {} pair(s) in {}", boardText, options.board.square_mm,
+                     listing.pairs.size(), pairsDir);
         for (const auto &pair : listing.pairs) {
             const cv::Mat l = cv::imread(pair.left, cv::IMREAD_GRAYSCALE), r = cv::imread(pair.right, cv::IMREAD_GRAYSCALE);
             const PairRecord &rec = l.empty() || r.empty()
@@ -155,14 +171,13 @@ int calibrate(const Args &args) {
         }
     } else {
         Source source(*rig->source.record, rig->source.params);
-        std::cerr << "binocle calibrate: " << boardText << " board, " << options.board.square_mm << " mm squares, pairs from source '"
-                  << rig->source.plugin << "'"
-                  << (live ? " (live: a pair is taken when the board has been still for " + std::to_string(stillFrames) + " frames)"
-                           : "")
-                  << "\n";
+        spdlog::info("binocle calibrate: {} board, {} mm squares, pairs from source '{}'{}", boardText, options.board.square_mm,
+                     rig->source.plugin,
+                     live ? " (live: a pair is taken when the board has been still for " + std::to_string(stillFrames) + " frames)" : "");
         source.start();
         StillBoard still(static_cast<int>(stillFrames), stillPx, 20.0);
-        const bool tty = ::isatty(2) != 0;
+        // The frame count and the board's state; the screened pairs are logged above it.
+        Progress progress(live, "frame", maxFrames);
         long long frames = 0;
         while ((maxFrames < 0 || frames < maxFrames) && (wanted < 0 || calibrator.goodPairs() < wanted)) {
             std::unique_ptr<LentFrame> frame = source.grab(5000);
@@ -177,16 +192,14 @@ int calibrate(const Args &args) {
             BoardView l = findBoard(frame->left(), options.board, true), r = findBoard(frame->right(), options.board, true);
             if (still.update(l, r)) {
                 const PairRecord &rec = calibrator.addViews(id, frame->left().size(), std::move(l), std::move(r), leftFile, rightFile);
-                if (tty) std::cerr << "\r";
                 printScreened(rec);
             }
-            const std::string status = "frame " + std::to_string(frames) + ": " + std::to_string(calibrator.goodPairs()) +
-                                       (wanted > 0 ? "/" + std::to_string(wanted) : "") + " good pairs, board " +
-                                       (l.found || r.found ? "still for " + std::to_string(still.stillFrames()) + " frame(s)" : "not in view");
-            if (tty) std::cerr << "\r" << pad(status, 70) << std::flush;
-            else if (frames % 30 == 0) std::cerr << "  " << status << "\n";
+            progress.update(frames, std::to_string(calibrator.goodPairs()) + (wanted > 0 ? "/" + std::to_string(wanted) : "") +
+                                        " good pairs, board " +
+                                        (l.found || r.found ? "still for " + std::to_string(still.stillFrames()) + " frame(s)"
+                                                            : "not in view"));
         }
-        if (tty && live) std::cerr << "\n";
+        progress.finish();
         source.stop();
         if (calibrator.pairs().empty()) throw Error("source '" + rig->source.plugin + "' delivered no pair to calibrate with");
     }
@@ -201,12 +214,13 @@ int calibrate(const Args &args) {
     if (!focalMm && pixelPitchUm > 0) focalMm = fx * pixelPitchUm / 1000.0;
     c.configuration = configurationName(stated.baseline_mm.value_or(c.baselineMm()), focalMm, fx);
     if (stated.baseline_mm && std::abs(c.baselineMm() - *stated.baseline_mm) > 0.05 * *stated.baseline_mm)
-        std::cerr << "  warning: recovered baseline " << fixed(c.baselineMm(), 1) << " mm but the rig says baseline_mm: "
-                  << *stated.baseline_mm << "; pipelines will refuse this calibration (check --square-mm and the rig)\n";
+        spdlog::warn("recovered baseline {} mm but the rig says baseline_mm: {}; pipelines will refuse this calibration "
+                     "(check --square-mm and the rig)",
+                     fixed(c.baselineMm(), 1), *stated.baseline_mm);
     if (stated.focal_length_mm && pixelPitchUm > 0 &&
         std::abs(fx * pixelPitchUm / 1000.0 - *stated.focal_length_mm) > 0.05 * *stated.focal_length_mm)
-        std::cerr << "  warning: recovered focal length " << fixed(fx * pixelPitchUm / 1000.0, 2)
-                  << " mm but the rig says focal_length_mm: " << *stated.focal_length_mm << "\n";
+        spdlog::warn("recovered focal length {} mm but the rig says focal_length_mm: {}", fixed(fx * pixelPitchUm / 1000.0, 2),
+                     *stated.focal_length_mm);
 
     std::string path = out;
     const std::string fileName = "calib_" + c.configuration + ".yml";
@@ -215,15 +229,13 @@ int calibrate(const Args &args) {
     else if (path.back() == '/' || fs::is_directory(path, ec)) path = (fs::path(path) / fileName).string();
     const CalibrationFiles files = CalibrationFiles::beside(path);
     writeCalibrationFiles(files, c, calibrationReport(result, options, pixelPitchUm));
-    std::cerr << "  wrote " << files.calibration << " (configuration " << c.configuration << "), " << baseName(files.left_info)
-              << ", " << baseName(files.right_info) << ", " << baseName(files.report) << "\n";
+    spdlog::info("  wrote {} (configuration {}), {}, {}, {}", files.calibration, c.configuration, baseName(files.left_info),
+                 baseName(files.right_info), baseName(files.report));
     std::cout << files.calibration << "\n";
     return 0;
 }
 
-Register reg({"calibrate", "stereo calibration from chessboard pairs: calib_B<mm>_f<mm>.yml per configuration",
-              "usage: binocle calibrate [RIG.yaml] --board COLSxROWS --square-mm S [--pairs DIR | --live]\n"
-              "                         [--out FILE] [--set KEY=VALUE]... [options]\n\n"
+Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm>_f<mm>.yml per configuration",
               "Calibrates one configuration of the head (baseline, lenses) from chessboard pairs:\n"
               "finds the board with sub-pixel corners in each pair, rejects poor pairs and says why\n"
               "(board not found, too small, blurred, corner order flipped between left and right),\n"
@@ -241,25 +253,45 @@ Register reg({"calibrate", "stereo calibration from chessboard pairs: calib_B<mm
               "  (default)           every frame of the rig's source (replay of files, sim's calibration_board)\n"
               "  --live              the rig's source, a pair taken when the board has been still for\n"
               "                      --still-frames frames (corners moved < --still-px) and has moved\n"
-              "                      since the last pair; good pairs counted on stderr\n\n"
-              "  --board COLSxROWS   inner corners per row and per column, e.g. 9x6 (required)\n"
-              "  --square-mm S       side of one square in mm (required; the baseline scales with it)\n"
-              "  --out FILE          the calibration file (default: calib_<configuration>.yml here);\n"
-              "                      an existing folder: that file in it\n"
-              "  --pairs-wanted N    stop after N good pairs (default 12 with --live, else all frames)\n"
-              "  --frames N          read at most N frames from the source\n"
-              "  --still-frames N    live: frames the board must be still (default 5)\n"
-              "  --still-px P        live: largest corner motion of a still board (default 1)\n"
-              "  --pixel-pitch-um P  pixel pitch, for focal lengths in mm (default: the rig's pixel_pitch_um)\n"
-              "  --min-board-percent A  reject boards covering less of the image (default 1.5)\n"
-              "  --max-edge-width-px W  reject blurred boards, edges wider than W px (default 4)\n"
-              "  --max-pair-error-px E  drop pairs with a larger reprojection error and recalibrate (default 1)\n"
-              "  --min-pairs N       fewest good pairs to calibrate with (default 4)\n"
-              "  --fix-intrinsic     keep each camera's own calibration in the stereo step\n"
-              "  --fix-k3            distortion k1, k2, p1, p2 only\n"
-              "  --set KEY=VALUE     override a value of the rig, e.g. --set source.baseline_mm=190\n",
-              {"--live", "--fix-intrinsic", "--fix-k3"},
-              calibrate});
+              "                      since the last pair; good pairs counted on stderr",
+              [](CLI::App &app) -> Runner {
+                  auto a = std::make_shared<CalibrateArgs>();
+                  addRigArgs(app, a->rig, false);
+                  app.add_option("--board", a->board, "inner corners per row and per column, e.g. 9x6")->type_name("COLSxROWS")->required();
+                  app.add_option("--square-mm", a->square_mm, "side of one square in mm (the baseline scales with it)")
+                      ->type_name("S")
+                      ->required();
+                  app.add_option("--pairs", a->pairs, "image pairs left<N>.png|jpg and right<N>.* in this folder")->type_name("DIR");
+                  app.add_flag("--live", a->live, "pairs from the rig's source, taken when the board is still");
+                  app.add_option("--out", a->out, "the calibration file (default: calib_<configuration>.yml here); an existing folder: that file in it")
+                      ->type_name("FILE");
+                  app.add_option("--pairs-wanted", a->pairs_wanted, "stop after N good pairs (default 12 with --live, else all frames)")
+                      ->type_name("N");
+                  app.add_option("--frames", a->frames, "read at most N frames from the source")->type_name("N")->check(atLeast(1));
+                  app.add_option("--still-frames", a->still_frames, "live: frames the board must be still (default 5)")
+                      ->type_name("N")
+                      ->check(atLeast(2));
+                  app.add_option("--still-px", a->still_px, "live: largest corner motion of a still board (default 1)")
+                      ->type_name("PX")
+                      ->check(positiveNumber());
+                  app.add_option("--pixel-pitch-um", a->pixel_pitch_um, "pixel pitch, for focal lengths in mm (default: the rig's pixel_pitch_um)")
+                      ->type_name("UM")
+                      ->check(positiveNumber());
+                  app.add_option("--min-board-percent", a->options.min_board_area_percent,
+                                 "reject boards covering less of the image (default 1.5)")
+                      ->type_name("A");
+                  app.add_option("--max-edge-width-px", a->options.max_edge_width_px, "reject blurred boards, edges wider than W px (default 4)")
+                      ->type_name("W");
+                  app.add_option("--max-pair-error-px", a->options.max_pair_error_px,
+                                 "drop pairs with a larger reprojection error and recalibrate (default 1)")
+                      ->type_name("E");
+                  app.add_option("--min-pairs", a->options.min_pairs, "fewest good pairs to calibrate with (default 4)")
+                      ->type_name("N")
+                      ->check(atLeast(3));
+                  app.add_flag("--fix-intrinsic", a->options.fix_intrinsic, "keep each camera's own calibration in the stereo step");
+                  app.add_flag("--fix-k3", a->options.fix_k3, "distortion k1, k2, p1, p2 only");
+                  return [a, &app] { return calibrate(*a, app); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

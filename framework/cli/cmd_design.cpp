@@ -14,13 +14,23 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
+#include <spdlog/spdlog.h>
 #include <sstream>
 
 namespace fs = std::filesystem;
 
 namespace binocle::cli {
 namespace {
+
+struct DesignArgs {
+    std::string range, band, lenses = "2.8,4,8,12,16", baselines = "100:200:10";
+    double pixel_pitch_um = 20.8, camera_height_mm = 1500, inclination_deg = 0;
+    double panel_width_mm = 2500, panel_height_mm = 2000;
+    int image_width = 320, image_height = 240, num_disparities = 64;
+    int top = 10, simulate_count = 12;
+    bool simulate = false, quiet = false;
+    std::string rig, out;
+};
 
 std::vector<double> numberList(const std::string &option, const std::string &text) {
     std::vector<double> out;
@@ -31,7 +41,7 @@ std::vector<double> numberList(const std::string &option, const std::string &tex
             out.push_back(std::stod(item, &used));
             if (used != item.size()) throw std::invalid_argument(item);
         } catch (const std::logic_error &) {
-            throw Error(option + " " + text + ": '" + item + "' is not a number (expected e.g. 2.8,4,8)");
+            throw UsageError(option + " " + text + ": '" + item + "' is not a number (expected e.g. 2.8,4,8)");
         }
     }
     return out;
@@ -43,7 +53,7 @@ std::vector<double> baselines(const std::string &text) {
     std::vector<double> p;
     std::stringstream ss(text);
     for (std::string item; std::getline(ss, item, ':');) p.push_back(numberList("--baselines", item).at(0));
-    if (p.size() != 3 || !(p[2] > 0) || p[1] < p[0]) throw Error("--baselines " + text + ": expected MIN:MAX:STEP in mm, e.g. 100:200:10");
+    if (p.size() != 3 || !(p[2] > 0) || p[1] < p[0]) throw UsageError("--baselines " + text + ": expected MIN:MAX:STEP in mm, e.g. 100:200:10");
     std::vector<double> out;
     for (double b = p[0]; b <= p[1] + 1e-9; b += p[2]) out.push_back(b);
     return out;
@@ -64,34 +74,33 @@ double ffDistance(double ff) {
     return ff < 1.2 ? std::log(1.2 / ff) : std::log(ff / 2.0);
 }
 
-int run(const Args &args) {
+int design(const DesignArgs &args) {
     std::vector<double> ranges;
-    if (args.has("--range")) ranges = numberList("--range", args.get("--range"));
-    if (args.has("--band")) {
-        auto b = numberList("--band", args.get("--band"));
-        if (b.size() != 2 || !(b[0] > 0) || b[1] <= b[0]) throw Error("--band " + args.get("--band") + ": expected MIN,MAX in mm, e.g. 5000,12000");
+    if (!args.range.empty()) ranges = numberList("--range", args.range);
+    if (!args.band.empty()) {
+        auto b = numberList("--band", args.band);
+        if (b.size() != 2 || !(b[0] > 0) || b[1] <= b[0]) throw UsageError("--band " + args.band + ": expected MIN,MAX in mm, e.g. 5000,12000");
         for (int i = 0; i <= 4; ++i) ranges.push_back(b[0] + (b[1] - b[0]) * i / 4.0);
     }
-    if (ranges.empty()) throw Error("give a target: --range 6000 (mm) or --band 5000,12000 (see --help)");
+    if (ranges.empty()) throw UsageError("give a target: --range 6000 (mm) or --band 5000,12000");
     for (double r : ranges)
-        if (!(r > 0)) throw Error("--range: " + std::to_string(r) + " mm: expected a positive range");
-    const std::vector<double> lenses = numberList("--lenses", args.get("--lenses", "2.8,4,8,12,16"));
-    const std::vector<double> bases = baselines(args.get("--baselines", "100:200:10"));
+        if (!(r > 0)) throw UsageError("--range: " + std::to_string(r) + " mm: expected a positive range");
+    const std::vector<double> lenses = numberList("--lenses", args.lenses);
+    const std::vector<double> bases = baselines(args.baselines);
     method::StereoDesign head;
-    head.pixel_pitch_um = args.real("--pixel-pitch-um", 20.8);
-    head.image_width_px = static_cast<int>(args.integer("--image-width", 320));
-    head.image_height_px = static_cast<int>(args.integer("--image-height", 240));
-    head.num_disparities = static_cast<int>(args.integer("--num-disparities", 64));
-    head.camera_height_mm = args.real("--camera-height-mm", 1500);
-    head.inclination_deg = args.real("--inclination-deg", 0);
+    head.pixel_pitch_um = args.pixel_pitch_um;
+    head.image_width_px = args.image_width;
+    head.image_height_px = args.image_height;
+    head.num_disparities = args.num_disparities;
+    head.camera_height_mm = args.camera_height_mm;
+    head.inclination_deg = args.inclination_deg;
     method::PanelPlacement panel;
-    panel.width_mm = args.real("--panel-width-mm", 2500);
-    panel.height_mm = args.real("--panel-height-mm", 2000);
+    panel.width_mm = args.panel_width_mm;
+    panel.height_mm = args.panel_height_mm;
     for (double v : lenses)
-        if (!(v > 0)) throw Error("--lenses: focal lengths must be positive mm");
+        if (!(v > 0)) throw UsageError("--lenses: focal lengths must be positive mm");
     for (double v : bases)
-        if (!(v > 0)) throw Error("--baselines: baselines must be positive mm");
-    if (!(head.pixel_pitch_um > 0)) throw Error("--pixel-pitch-um must be positive");
+        if (!(v > 0)) throw UsageError("--baselines: baselines must be positive mm");
 
     std::vector<Candidate> cands;
     for (double b : bases)
@@ -118,13 +127,13 @@ int run(const Args &args) {
     };
     std::stable_sort(cands.begin(), cands.end(), byFigures);
 
-    const size_t top = static_cast<size_t>(std::max<long long>(1, args.integer("--top", 10)));
-    if (args.has("--simulate")) {
+    const size_t top = static_cast<size_t>(args.top);
+    if (args.simulate) {
         // Measure η3D on the simulated rig for the best `--simulate-count` by figures.
-        const size_t n = std::min(cands.size(), static_cast<size_t>(std::max<long long>(1, args.integer("--simulate-count", 12))));
+        const size_t n = std::min(cands.size(), static_cast<size_t>(args.simulate_count));
         PluginHost host;
         host.scan();
-        const std::string rig = args.get("--rig", dataFile("configs/rigs/sim-e1.yaml"));
+        const std::string rig = args.rig.empty() ? dataFile("configs/rigs/sim-e1.yaml") : args.rig;
         std::vector<TestGeometry> tests;
         std::vector<size_t> which;
         for (size_t i = 0; i < n; ++i)
@@ -134,29 +143,16 @@ int run(const Args &args) {
             }
         Experiment e = makeExperiment("design", rig, tests, host);
         ExperimentOptions opt;
-        opt.out_dir = args.get("--out", "out/design") + "/simulated";
-        opt.progress = !args.has("--quiet");
-        runExperiment(e, host, opt);
-        // Read η3D back from the table the experiment wrote.
-        const std::string csv = readTextFile(opt.out_dir + "/results.csv");
-        std::stringstream lines(csv);
-        std::string header;
-        std::getline(lines, header);
-        std::vector<std::string> cols;
-        std::stringstream hs(header);
-        for (std::string c; std::getline(hs, c, ',');) cols.push_back(c);
-        const auto col = std::find(cols.begin(), cols.end(), "eta_3d_percent") - cols.begin();
+        opt.out_dir = (args.out.empty() ? std::string("out/design") : args.out) + "/simulated";
+        opt.progress = !args.quiet;
+        const ExperimentResult result = runExperiment(e, host, opt);
+        // Averaged over the band: a configuration is as good as it is across it.
         std::vector<double> sum(n, 0), cnt(n, 0);
-        size_t t = 0;
-        for (std::string line; std::getline(lines, line) && t < which.size(); ++t) {
-            std::vector<std::string> cells;
-            std::stringstream ls(line);
-            for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
-            if (static_cast<size_t>(col) < cells.size() && !cells[col].empty()) {
-                // Averaged over the band: a configuration is as good as it is across it.
-                sum[which[t]] += std::stod(cells[col]);
-                cnt[which[t]] += 1;
-            }
+        for (size_t t = 0; t < result.rows.size() && t < which.size(); ++t) {
+            const double eta = result.rows[t].get("eta_3d_percent");
+            if (!std::isfinite(eta)) continue;
+            sum[which[t]] += eta;
+            cnt[which[t]] += 1;
         }
         for (size_t i = 0; i < n; ++i) cands[i].eta_3d = cnt[i] ? sum[i] / cnt[i] : 0.0;
         std::stable_sort(cands.begin(), cands.begin() + static_cast<long>(n),
@@ -164,7 +160,7 @@ int run(const Args &args) {
     }
 
     // Table on stdout, JSON and CSV in --out.
-    const bool sim = args.has("--simulate");
+    const bool sim = args.simulate;
     std::printf("%-4s %8s %7s %7s %9s %10s %9s %7s %s\n", "rank", "B (mm)", "f (mm)", "FF", "d (px)", "dR (mm)", "Rmin (m)",
                 "panel", sim ? "η3D (%)" : "reading");
     Json list = Json::array();
@@ -178,21 +174,22 @@ int run(const Args &args) {
                         x.form_factor, x.disparity_px, x.depth_resolution_mm, x.min_range_mm / 1000,
                         c.panel_fits ? "fits" : "cut", sim ? (std::isfinite(c.eta_3d) ? std::to_string(c.eta_3d).substr(0, 5).c_str() : "-")
                                                            : method::formFactorReading(x.form_factor));
-        Json j = Json::object();
-        j.set("rank", static_cast<int64_t>(i + 1)).set("baseline_mm", c.baseline_mm).set("focal_length_mm", c.focal_length_mm);
-        j.set("panel_fits", c.panel_fits).set("search_reaches_range", c.in_search);
-        if (std::isfinite(c.eta_3d)) j.set("eta_3d_percent", c.eta_3d);
+        Json j = {{"rank", i + 1},
+                  {"baseline_mm", c.baseline_mm},
+                  {"focal_length_mm", c.focal_length_mm},
+                  {"panel_fits", c.panel_fits},
+                  {"search_reaches_range", c.in_search}};
+        if (std::isfinite(c.eta_3d)) j["eta_3d_percent"] = c.eta_3d;
         Json per = Json::array();
         for (const auto &f : c.at) {
-            per.push(Json::object()
-                         .set("range_mm", f.range_mm)
-                         .set("form_factor", f.form_factor)
-                         .set("reading", method::formFactorReading(f.form_factor))
-                         .set("disparity_px", f.disparity_px)
-                         .set("depth_resolution_mm", f.depth_resolution_mm)
-                         .set("min_range_mm", f.min_range_mm)
-                         .set("horizontal_fov_deg", f.horizontal_fov_deg)
-                         .set("stereo_field_width_mm", f.stereo_field_width_mm));
+            per.push_back({{"range_mm", f.range_mm},
+                           {"form_factor", f.form_factor},
+                           {"reading", method::formFactorReading(f.form_factor)},
+                           {"disparity_px", f.disparity_px},
+                           {"depth_resolution_mm", f.depth_resolution_mm},
+                           {"min_range_mm", f.min_range_mm},
+                           {"horizontal_fov_deg", f.horizontal_fov_deg},
+                           {"stereo_field_width_mm", f.stereo_field_width_mm}});
             char row[256];
             std::snprintf(row, sizeof row, "%zu,%g,%g,%g,%.4f,%.4f,%.2f,%.1f,%.1f,%d,%s\n", i + 1, c.baseline_mm,
                           c.focal_length_mm, f.range_mm, f.form_factor, f.disparity_px, f.depth_resolution_mm, f.min_range_mm,
@@ -200,45 +197,63 @@ int run(const Args &args) {
                           std::isfinite(c.eta_3d) ? std::to_string(c.eta_3d).c_str() : "");
             csv += row;
         }
-        j.set("ranges", std::move(per));
-        list.push(std::move(j));
+        j["ranges"] = std::move(per);
+        list.push_back(std::move(j));
     }
-    if (args.has("--out")) {
+    if (!args.out.empty()) {
         std::error_code ec;
-        fs::create_directories(args.get("--out"), ec);
-        writeFileAtomic(args.get("--out") + "/design.json", Json::object().set("candidates", std::move(list)).dump());
-        writeFileAtomic(args.get("--out") + "/design.csv", csv);
-        std::cerr << "design: " << cands.size() << " configurations ranked; design.json and design.csv in " << args.get("--out") << "\n";
+        fs::create_directories(args.out, ec);
+        writeFileAtomic(args.out + "/design.json", dumpJson(Json{{"candidates", std::move(list)}}));
+        writeFileAtomic(args.out + "/design.csv", csv);
+        spdlog::info("design: {} configurations ranked; design.json and design.csv in {}", cands.size(), args.out);
     }
     return 0;
 }
 
-Register reg({"design", "rank baselines and lenses for a target range or band by FF (Eq. 7), or by simulated η3D",
-              "usage: binocle design (--range MM[,MM...] | --band MIN,MAX) [options]\n\n"
+Register reg{{"design", "rank baselines and lenses for a target range or band by FF (Eq. 7), or by simulated η3D",
               "Ranks every combination of the available baselines and lenses for the target\n"
               "range(s): configurations that see the whole test panel and whose disparity search\n"
               "reaches the range first, then by how close the form factor FF = 10·B·f/R (Eq. 7)\n"
               "lies to the paper's best band 1.2-2.0 (worst range of the band counts), then by\n"
               "depth resolution. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
               "depth resolution dR = R²·p·Δd/(B·f) for Δd = 0.25 px, the minimum range of the\n"
-              "disparity search and whether the panel fits the stereo field.\n\n"
-              "  --range 6000,12000        target range(s) in mm\n"
-              "  --band 5000,12000         a range band in mm (5 ranges across it)\n"
-              "  --lenses 2.8,4,8,12,16    focal lengths available, mm (default: the Videre set)\n"
-              "  --baselines 100:200:10    baselines, mm: MIN:MAX:STEP or a list (default 100:200:10)\n"
-              "  --pixel-pitch-um 20.8     effective pixel pitch (default: Videre head decimated by 4)\n"
-              "  --image-width 320 --image-height 240   image size in pixels\n"
-              "  --num-disparities 64      the matcher's disparity search\n"
-              "  --camera-height-mm 1500 --inclination-deg 0\n"
-              "  --panel-width-mm 2500 --panel-height-mm 2000   the object that must fit\n"
-              "  --top 10                  rows printed\n"
-              "  --simulate                measure η3D on the simulated rig for the best candidates\n"
-              "  --simulate-count 12       how many candidates to simulate\n"
-              "  --rig FILE                base rig for --simulate (default configs/rigs/sim-e1.yaml)\n"
-              "  --out DIR                 write design.json and design.csv (and simulated/ runs)\n"
-              "  --quiet                   no progress bar\n",
-              {"--simulate", "--quiet"},
-              run});
+              "disparity search and whether the panel fits the stereo field.\n"
+              "One of --range or --band is required.",
+              [](CLI::App &app) -> Runner {
+                  auto a = std::make_shared<DesignArgs>();
+                  app.add_option("--range", a->range, "target range(s) in mm, e.g. 6000,12000")->type_name("MM[,MM...]");
+                  app.add_option("--band", a->band, "a range band in mm (5 ranges across it), e.g. 5000,12000")
+                                   ->type_name("MIN,MAX");
+                  app.add_option("--lenses", a->lenses, "focal lengths available, mm (default: the Videre set 2.8,4,8,12,16)")
+                      ->type_name("MM,MM...");
+                  app.add_option("--baselines", a->baselines, "baselines, mm: MIN:MAX:STEP or a list (default 100:200:10)")
+                      ->type_name("SPEC");
+                  app.add_option("--pixel-pitch-um", a->pixel_pitch_um, "effective pixel pitch (default 20.8: Videre head decimated by 4)")
+                      ->type_name("UM")
+                      ->check(positiveNumber());
+                  app.add_option("--image-width", a->image_width, "image width in pixels (default 320)")->type_name("PX")->check(atLeast(1));
+                  app.add_option("--image-height", a->image_height, "image height in pixels (default 240)")->type_name("PX")->check(atLeast(1));
+                  app.add_option("--num-disparities", a->num_disparities, "the matcher's disparity search (default 64)")
+                      ->type_name("N")
+                      ->check(atLeast(1));
+                  app.add_option("--camera-height-mm", a->camera_height_mm, "camera height (default 1500)")->type_name("MM");
+                  app.add_option("--inclination-deg", a->inclination_deg, "inclination (default 0)")->type_name("DEG")->check(CLI::Range(-89.0, 89.0));
+                  app.add_option("--panel-width-mm", a->panel_width_mm, "width of the object that must fit (default 2500)")
+                      ->type_name("MM")
+                      ->check(positiveNumber());
+                  app.add_option("--panel-height-mm", a->panel_height_mm, "height of the object that must fit (default 2000)")
+                      ->type_name("MM")
+                      ->check(positiveNumber());
+                  app.add_option("--top", a->top, "rows printed (default 10)")->type_name("N")->check(atLeast(1));
+                  app.add_flag("--simulate", a->simulate, "measure η3D on the simulated rig for the best candidates");
+                  app.add_option("--simulate-count", a->simulate_count, "how many candidates to simulate (default 12)")
+                      ->type_name("N")
+                      ->check(atLeast(1));
+                  app.add_option("--rig", a->rig, "base rig for --simulate (default configs/rigs/sim-e1.yaml)")->type_name("FILE");
+                  app.add_option("--out", a->out, "write design.json and design.csv (and simulated/ runs)")->type_name("DIR");
+                  app.add_flag("--quiet", a->quiet, "no progress display");
+                  return [a] { return design(*a); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

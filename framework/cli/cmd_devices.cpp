@@ -5,6 +5,7 @@
 #include "host/plugin_host.hpp"
 
 #include <iostream>
+#include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
 namespace binocle::cli {
@@ -30,12 +31,12 @@ std::string indentedList(const std::string &yaml) {
     return out;
 }
 
-int run(const Args &args) {
+int listDevices(const std::string &plugin) {
     PluginHost host;
     host.scan();
     std::vector<const PluginRecord *> sources;
-    if (args.has("--plugin")) {
-        sources.push_back(&host.require(args.get("--plugin"), BINOCLE_KIND_STEREO_SOURCE));
+    if (!plugin.empty()) {
+        sources.push_back(&host.require(plugin, BINOCLE_KIND_STEREO_SOURCE));
     } else {
         for (const auto &p : host.plugins())
             if (p.kind == BINOCLE_KIND_STEREO_SOURCE) sources.push_back(&p);
@@ -54,14 +55,13 @@ int run(const Args &args) {
             YAML::Emitter message;
             message << std::string(e.what());
             std::cout << "  error: " << message.c_str() << "\n" << std::flush;
-            std::cerr << "binocle devices: " << p->name << ": " << e.what() << "\n";
+            spdlog::error("{}: {}", p->name, e.what());
         }
     }
     return failures == 0 ? 0 : 1;
 }
 
-Register reg({"devices", "list the devices each source plugin can see (cameras, stereo heads)",
-              "usage: binocle devices [--plugin NAME]\n\n"
+Register reg{{"devices", "list the devices each source plugin can see (cameras, stereo heads)",
               "Asks every source plugin (or only NAME) which devices it can open and prints\n"
               "them as YAML, one key per plugin:\n"
               "  gige:\n"
@@ -70,10 +70,12 @@ Register reg({"devices", "list the devices each source plugin can see (cameras, 
               "        description: ...\n"
               "A plugin that fails is listed with `error:` and the others are still asked;\n"
               "the exit status is then 1. Plugins that talk to networks (gige) send discovery\n"
-              "broadcasts on every interface.\n\n"
-              "  --plugin NAME   ask this source plugin only\n",
-              {},
-              run});
+              "broadcasts on every interface.",
+              [](CLI::App &app) -> Runner {
+                  auto plugin = std::make_shared<std::string>();
+                  app.add_option("--plugin", *plugin, "ask this source plugin only")->type_name("NAME");
+                  return [plugin] { return listDevices(*plugin); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

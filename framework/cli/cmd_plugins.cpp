@@ -10,11 +10,15 @@
 namespace binocle::cli {
 namespace {
 
-int run(const Args &args) {
+struct PluginsArgs {
+    bool verbose = false;
+    std::vector<std::string> load;
+};
+
+int listPlugins(const PluginsArgs &args) {
     PluginHost host;
-    for (const auto &p : args.all("--load")) host.load(p);
+    for (const auto &p : args.load) host.load(p);
     host.scan();
-    const bool verbose = args.has("--verbose");
     std::cout << "search path:\n";
     for (const auto &d : host.searchPath()) std::cout << "  " << d << "\n";
     std::cout << "\nplugins (host ABI " << BINOCLE_ABI_VERSION << ", API " << BINOCLE_API_VERSION << "):\n";
@@ -24,7 +28,7 @@ int run(const Args &args) {
     for (const auto &p : host.plugins()) {
         std::cout << "  " << std::left << std::setw(static_cast<int>(nameWidth)) << p.name << std::setw(10) << kindName(p.kind) << std::setw(9)
                   << p.version << "ABI " << p.abi_version << " API " << p.api_version << "  " << p.description << "\n";
-        if (verbose) {
+        if (args.verbose) {
             std::cout << "      file: " << p.path << "\n";
             for (const auto &d : p.params())
                 std::cout << "      " << std::setw(24) << d.name << (d.default_value ? d.default_value : "(required)")
@@ -38,15 +42,18 @@ int run(const Args &args) {
     return 0;
 }
 
-Register reg({"plugins", "list the plugins found, with versions, and those refused and why",
-              "usage: binocle plugins [--verbose] [--load FILE]...\n\n"
+Register reg{{"plugins", "list the plugins found, with versions, and those refused and why",
               "Lists every plugin in the search path ($BINOCLE_PLUGIN_PATH, then the install\n"
               "prefix, then the build tree) with its kind, version and ABI/API versions, and\n"
-              "every file that was refused with the reason.\n\n"
-              "  --verbose     also show each plugin's file and settings (YAML keys)\n"
-              "  --load FILE   load this plugin file as well (repeatable)\n",
-              {"--verbose"},
-              run});
+              "every file that was refused with the reason.",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<PluginsArgs>();
+                  app.add_flag("--verbose", args->verbose, "also show each plugin's file and settings (YAML keys)");
+                  app.add_option("--load", args->load, "load this plugin file as well (repeatable)")
+                      ->type_name("FILE")
+                      ->allow_extra_args(false);
+                  return [args] { return listPlugins(*args); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

@@ -3,8 +3,9 @@
 // plugin plays back (layout `recording`, plugins/replay/README.md).
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
-#include "core/error.hpp"
 #include "pipeline/recorder.hpp"
+
+#include <spdlog/spdlog.h>
 
 #include <atomic>
 #include <csignal>
@@ -24,38 +25,40 @@ extern "C" void onStopSignal(int sig) {
     }
 }
 
-int run(const Args &args) {
-    if (args.positional().size() != 1) throw Error("expected one rig file: binocle record RIG.yaml --out DIR (see --help)");
-    if (!args.has("--out") || args.get("--out").empty()) throw Error("missing --out DIR: the folder to record into");
+struct RecordArgs {
+    RigArgs rig;
+    std::string out;
+    int64_t frames = -1;
+    int32_t timeout_ms = 5000;
+    bool statistics = false, quiet = false;
+};
+
+int record(const RecordArgs &args) {
+    if (args.out.empty()) throw UsageError("--out: expected the folder to record into");
     PluginHost host;
     host.scan();
-    RigConfig rig = loadRigFromArgs(args, host);
+    RigConfig rig = loadRig(args.rig, host);
     RecordOptions options;
-    options.max_frames = args.integer("--frames", -1);
-    if (args.has("--frames") && options.max_frames < 1)
-        throw Error("option --frames = " + args.get("--frames") + ": expected a positive number of frames");
-    options.grab_timeout_ms = static_cast<int32_t>(args.integer("--timeout-ms", 5000));
-    options.progress = !args.has("--quiet");
+    options.max_frames = args.frames;
+    options.grab_timeout_ms = args.timeout_ms;
+    options.progress = !args.quiet;
     options.stop = &stopRequested;
     std::signal(SIGINT, onStopSignal);
     std::signal(SIGTERM, onStopSignal);
-    const std::string dir = args.get("--out");
-    RecordResult r = recordRig(rig, dir, options);
+    RecordResult r = recordRig(rig, args.out, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
-    std::cerr << "binocle record: " << r.frames << " frame(s) of rig '" << rig.name << "' recorded to " << dir << " in " << r.seconds
-              << " s\n";
-    if (!r.source_statistics.empty() && args.has("--statistics")) std::cout << r.source_statistics;
+    spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, args.out, r.seconds);
+    if (!r.source_statistics.empty() && args.statistics) std::cout << r.source_statistics;
     if (!r.error.empty()) {
-        std::cerr << "binocle record: error: " << r.error << "\nbinocle record: the " << r.frames
-                  << " frame(s) already written are complete and replayable\n";
+        spdlog::error("{}", r.error);
+        spdlog::info("binocle record: the {} frame(s) already written are complete and replayable", r.frames);
         return 1;
     }
     return 0;
 }
 
-Register reg({"record", "record a rig's source (any plugin) to a folder that replay plays back",
-              "usage: binocle record RIG.yaml --out DIR [--frames N] [--set KEY=VALUE]... [--quiet]\n\n"
+Register reg{{"record", "record a rig's source (any plugin) to a folder that replay plays back",
               "Records the rig's source, frame by frame, into DIR in the `recording` layout of\n"
               "the replay plugin (plugins/replay/README.md):\n"
               "  left/NNNNNN.png, right/NNNNNN.png   lossless PNG, NNNNNN = the source's sequence\n"
@@ -65,16 +68,25 @@ Register reg({"record", "record a rig's source (any plugin) to a folder that rep
               "Each frame's images are written (temporary file, fsync, rename) before its\n"
               "frames.csv line, which is flushed and fsync'ed: a recording cut short (process\n"
               "killed, power lost) plays back up to its last complete frame. Replay it with\n"
-              "  source: {plugin: replay, folder: DIR}\n\n"
-              "  --out DIR           the recording folder; it must not exist or be empty\n"
-              "                      (an existing recording is never overwritten)\n"
-              "  --frames N          stop after N frames (default: until the source ends or Ctrl-C)\n"
-              "  --set KEY=VALUE     override any value of the rig, e.g. --set source.exposure_us=2000\n"
-              "  --timeout-ms MS     longest wait for one frame (default 5000)\n"
-              "  --statistics        print the source's statistics (YAML) at the end\n"
-              "  --quiet             no progress line\n",
-              {"--quiet", "--statistics"},
-              run});
+              "  source: {plugin: replay, folder: DIR}\n"
+              "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<RecordArgs>();
+                  addRigArgs(app, args->rig);
+                  app.add_option("--out", args->out,
+                                 "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
+                      ->type_name("DIR")
+                      ->required();
+                  app.add_option("--frames", args->frames, "stop after N frames (default: until the source ends or Ctrl-C)")
+                      ->type_name("N")
+                      ->check(atLeast(1));
+                  app.add_option("--timeout-ms", args->timeout_ms, "longest wait for one frame (default 5000)")
+                      ->type_name("MS")
+                      ->check(atLeast(1));
+                  app.add_flag("--statistics", args->statistics, "print the source's statistics (YAML) at the end");
+                  app.add_flag("--quiet", args->quiet, "no progress display");
+                  return [args] { return record(*args); };
+              }}};
 
 } // namespace
 } // namespace binocle::cli

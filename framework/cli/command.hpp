@@ -1,54 +1,71 @@
 // SPDX-License-Identifier: MIT
-// The `binocle` command: subcommands register themselves, one file each (cmd_*.cpp).
+// The `binocle` command: one file per subcommand (cmd_<name>.cpp) registers itself with
+// its options defined on a CLI11 app and the function that runs once they are parsed.
 #pragma once
 
 #include "config/rig_config.hpp"
+#include "core/error.hpp"
+
+#include <CLI/CLI.hpp>
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace binocle::cli {
 
-// Parsed command line of one subcommand: positionals, and --name value / --name=value
-// options (repeatable ones keep every value).
-class Args {
-public:
-    Args(std::vector<std::string> argv, const std::vector<std::string> &flags);
-    const std::vector<std::string> &positional() const { return positional_; }
-    bool has(const std::string &name) const { return options_.count(name) != 0; }
-    std::string get(const std::string &name, const std::string &def = "") const;
-    std::vector<std::string> all(const std::string &name) const;
-    // Integer option; throws binocle::Error naming the option and the value.
-    long long integer(const std::string &name, long long def) const;
-    double real(const std::string &name, double def) const;
+// Exit statuses of every command (README "Exit statuses").
+enum ExitStatus { kExitOk = 0, kExitFailed = 1, kExitUsage = 2 };
 
-private:
-    std::vector<std::string> positional_;
-    std::multimap<std::string, std::string> options_;
+// A mistake on the command line that CLI11 cannot see (options that exclude each other,
+// a malformed list): the command stops with exit status 2, like a parse error.
+class UsageError : public Error {
+public:
+    using Error::Error;
 };
+
+// What runs once the command line is parsed; returns the exit status. Exceptions:
+// UsageError -> 2, any other -> 1, with the message logged as an error.
+using Runner = std::function<int()>;
 
 struct Command {
     std::string name;
-    std::string summary;                 // one line for `binocle --help`
-    std::string help;                    // full text for `binocle <name> --help`
-    std::vector<std::string> flags;      // options that take no value (e.g. "--simulate")
-    std::function<int(const Args &)> run;
+    std::string summary;  // one line, for `binocle --help` (and the top of `binocle <name> --help`)
+    std::string details;  // shown after the options in `binocle <name> --help`
+    // Defines the command's positionals and options on `app` (bind them to a struct the
+    // returned Runner shares, e.g. a std::shared_ptr) and returns the Runner.
+    std::function<Runner(CLI::App &app)> define;
+};
+
+// One static object per command file: `Register reg{{"name", "summary", "details", define}};`
+struct Register {
+    explicit Register(Command c);
 };
 
 const std::map<std::string, Command> &commands();
 
-// The rig named by the first positional argument, with every --set override applied,
-// validated against the plugins `host` found.
-RigConfig loadRigFromArgs(const Args &args, const PluginHost &host);
+// The whole command line: global options (--log-level, --log-file, --version) and every
+// registered command as a subcommand. `runners` receives each subcommand's Runner.
+std::unique_ptr<CLI::App> makeApp(std::map<const CLI::App *, Runner> &runners);
+
+// The rig file and its --set overrides, for the commands that load a rig.
+struct RigArgs {
+    std::string file;
+    std::vector<std::string> overrides;
+};
+// RIG (positional; required unless `required` is false) and --set KEY=VALUE (repeatable).
+void addRigArgs(CLI::App &app, RigArgs &args, bool required = true);
+// The rig with every --set override applied, validated against the plugins `host` found.
+RigConfig loadRig(const RigArgs &args, const PluginHost &host);
+
+// Validators with messages in the words of the other errors.
+CLI::Validator atLeast(long long min);   // a whole number >= min
+CLI::Validator positiveNumber();         // a finite real > 0
 
 // A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
 // next to the executable, else from the source tree it was built from.
 std::string dataFile(const std::string &relative);
-
-struct Register {
-    explicit Register(Command c);
-};
 
 } // namespace binocle::cli

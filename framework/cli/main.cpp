@@ -1,141 +1,123 @@
 // SPDX-License-Identifier: MIT
-// `binocle`: entry point and subcommand dispatch.
+// `binocle`: parses the command line (CLI11), sets up logging, runs the chosen command.
 #include "cli/command.hpp"
-#include "core/error.hpp"
+#include "config/rig_config.hpp"
+#include "core/log.hpp"
 
-#include <binocle/abi.h>
+#include <spdlog/spdlog.h>
 
-#include <algorithm>
-#include <filesystem>
+#include <cstdlib>
 #include <iostream>
 
-namespace binocle::cli {
-
 namespace {
-std::map<std::string, Command> &registry() {
-    static std::map<std::string, Command> r;
-    return r;
-}
-} // namespace
 
-const std::map<std::string, Command> &commands() { return registry(); }
+using namespace binocle;
+using namespace binocle::cli;
 
-RigConfig loadRigFromArgs(const Args &args, const PluginHost &host) {
-    std::vector<Override> overrides;
-    for (const auto &s : args.all("--set")) overrides.push_back(Override::parse(s));
-    return loadRig(args.positional().at(0), overrides, host);
-}
-
-std::string dataFile(const std::string &relative) {
-    std::error_code ec;
-    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const auto installed = exe.parent_path().parent_path() / BINOCLE_DATA_INSTALL_DIR / relative;
-    if (!ec && std::filesystem::exists(installed)) return installed.string();
-    return (std::filesystem::path(BINOCLE_SOURCE_DIR) / relative).string();
-}
-
-Register::Register(Command c) { registry()[c.name] = std::move(c); }
-
-Args::Args(std::vector<std::string> argv, const std::vector<std::string> &flags) {
-    for (size_t i = 0; i < argv.size(); ++i) {
-        const std::string &a = argv[i];
-        if (a.rfind("--", 0) == 0 && a.size() > 2) {
-            const auto eq = a.find('=');
-            if (eq != std::string::npos) {
-                options_.emplace(a.substr(0, eq), a.substr(eq + 1));
-            } else if (std::find(flags.begin(), flags.end(), a) != flags.end()) {
-                options_.emplace(a, "1");
-            } else {
-                if (i + 1 >= argv.size()) throw Error("option " + a + " needs a value");
-                options_.emplace(a, argv[++i]);
-            }
-        } else {
-            positional_.push_back(a);
+// Every spelling of the options of `app` and of the top level (global options).
+std::vector<std::string> optionNames(const CLI::App &app) {
+    std::vector<std::string> names;
+    for (const CLI::App *a = &app; a; a = a->get_parent())
+        for (const CLI::Option *o : a->get_options()) {
+            for (const auto &l : o->get_lnames()) names.push_back("--" + l);
+            for (const auto &s : o->get_snames()) names.push_back("-" + s);
         }
+    return names;
+}
+
+// What CLI11 left unparsed, as one message: the first unknown option (with the nearest
+// known one) or the first argument too many.
+std::string extrasMessage(const CLI::App &app, const std::vector<std::string> &extras) {
+    for (const auto &x : extras) {
+        if (x.size() < 2 || x[0] != '-') continue;
+        const std::string name = x.substr(0, x.find('='));
+        std::vector<std::string> bare;
+        const std::vector<std::string> names = optionNames(app);
+        for (const auto &n : names) bare.push_back(n.substr(n.find_first_not_of('-')));
+        const std::string hint = nearest(name.substr(name.find_first_not_of('-')), bare);
+        std::string suggestion;
+        for (size_t i = 0; i < bare.size() && !hint.empty(); ++i)
+            if (bare[i] == hint) suggestion = names[i];
+        return "unknown option '" + name + "'" + (suggestion.empty() ? "" : "; did you mean '" + suggestion + "'?");
     }
+    return "unexpected argument '" + extras.front() + "'";
 }
 
-std::string Args::get(const std::string &name, const std::string &def) const {
-    auto it = options_.find(name);
-    return it == options_.end() ? def : it->second;
-}
-
-std::vector<std::string> Args::all(const std::string &name) const {
-    std::vector<std::string> out;
-    auto range = options_.equal_range(name);
-    for (auto it = range.first; it != range.second; ++it) out.push_back(it->second);
-    return out;
-}
-
-long long Args::integer(const std::string &name, long long def) const {
-    if (!has(name)) return def;
-    const std::string v = get(name);
-    try {
-        size_t used = 0;
-        long long x = std::stoll(v, &used);
-        if (used == v.size()) return x;
-    } catch (const std::logic_error &) {
-    }
-    throw Error("option " + name + " = '" + v + "': expected an integer");
-}
-
-double Args::real(const std::string &name, double def) const {
-    if (!has(name)) return def;
-    const std::string v = get(name);
-    try {
-        size_t used = 0;
-        double x = std::stod(v, &used);
-        if (used == v.size()) return x;
-    } catch (const std::logic_error &) {
-    }
-    throw Error("option " + name + " = '" + v + "': expected a number");
-}
-
-} // namespace binocle::cli
-
-namespace {
-
-void usage(std::ostream &os) {
-    os << "binocle: stereo camera design and processing framework\n\n"
-          "usage: binocle <command> [options]\n\ncommands:\n";
-    for (const auto &[name, c] : binocle::cli::commands()) {
-        std::string pad(name.size() < 12 ? 12 - name.size() : 1, ' ');
-        os << "  " << name << pad << c.summary << "\n";
-    }
-    os << "\nRun `binocle <command> --help` for a command's options.\n"
-          "Plugins are searched in $BINOCLE_PLUGIN_PATH, the install prefix and the build tree.\n";
+LogOptions plainLog(const std::string &program) {
+    LogOptions o;
+    o.program = program;
+    return o;
 }
 
 } // namespace
 
 int main(int argc, char **argv) {
-    using namespace binocle::cli;
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-        usage(args.empty() ? std::cerr : std::cout);
-        return args.empty() ? 2 : 0;
+    std::map<const CLI::App *, Runner> runners;
+    std::unique_ptr<CLI::App> app = makeApp(runners);
+    std::string logLevel = "info", logFile;
+    app->add_option("--log-level", logLevel, "trace, debug, info, warn, error or off (default info)")
+        ->envname("BINOCLE_LOG_LEVEL")
+        ->type_name("LEVEL");
+    app->add_option("--log-file", logFile, "also write the log (every level shown, with times) to FILE")->type_name("FILE");
+
+    setupLogging(plainLog("binocle"));
+    if (argc < 2) {
+        std::cerr << app->help();
+        return kExitUsage;
     }
-    if (args[0] == "--version") {
-        std::cout << "binocle " << BINOCLE_VERSION << " (plugin ABI " << BINOCLE_ABI_VERSION << ", API " << BINOCLE_API_VERSION << ")\n";
-        return 0;
+    if (std::string(argv[1]) == "help") {
+        std::cout << app->help();
+        return kExitOk;
     }
-    auto it = commands().find(args[0]);
-    if (it == commands().end()) {
-        std::cerr << "binocle: unknown command '" << args[0] << "'\n\n";
-        usage(std::cerr);
-        return 2;
-    }
-    const Command &cmd = it->second;
-    std::vector<std::string> rest(args.begin() + 1, args.end());
-    for (const auto &a : rest)
-        if (a == "--help" || a == "-h") {
-            std::cout << cmd.help;
-            return 0;
-        }
     try {
-        return cmd.run(Args(rest, cmd.flags));
+        app->parse(argc, argv);
+    } catch (const CLI::CallForHelp &e) {
+        return app->exit(e);
+    } catch (const CLI::CallForAllHelp &e) {
+        return app->exit(e);
+    } catch (const CLI::CallForVersion &e) {
+        return app->exit(e);
+    } catch (const CLI::ParseError &e) {
+        std::string program = "binocle";
+        for (const CLI::App *sub : app->get_subcommands()) program += " " + sub->get_name();
+        setupLogging(plainLog(program));
+        spdlog::error("{} (see `{} --help`)", e.what(), program);
+        return kExitUsage;
+    }
+    const std::vector<CLI::App *> chosen = app->get_subcommands();
+    const CLI::App *sub = chosen.empty() ? nullptr : chosen.front();
+    const std::string program = sub ? "binocle " + sub->get_name() : "binocle";
+    try {
+        setupLogging({program, parseLogLevel(logLevel, "--log-level"), logFile});
     } catch (const std::exception &e) {
-        std::cerr << "binocle " << cmd.name << ": error: " << e.what() << "\n";
-        return 1;
+        setupLogging(plainLog(program));
+        spdlog::error("{}", e.what());
+        return kExitUsage;
+    }
+    const std::vector<std::string> extras = app->remaining(true);
+    if (!sub) {
+        if (extras.empty()) {
+            std::cerr << app->help();
+            return kExitUsage;
+        }
+        std::vector<std::string> names;
+        for (const auto &[name, c] : commands()) names.push_back(name);
+        const std::string hint = nearest(extras.front(), names);
+        spdlog::error("unknown command '{}'{} (see `binocle --help`)", extras.front(),
+                      hint.empty() ? "" : "; did you mean '" + hint + "'?");
+        return kExitUsage;
+    }
+    if (!extras.empty()) {
+        spdlog::error("{} (see `{} --help`)", extrasMessage(*sub, extras), program);
+        return kExitUsage;
+    }
+    try {
+        return runners.at(sub)();
+    } catch (const UsageError &e) {
+        spdlog::error("{} (see `{} --help`)", e.what(), program);
+        return kExitUsage;
+    } catch (const std::exception &e) {
+        spdlog::error("{}", e.what());
+        return kExitFailed;
     }
 }

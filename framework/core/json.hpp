@@ -1,53 +1,20 @@
 // SPDX-License-Identifier: MIT
-// A small JSON value for result files (summary.json, results.json): build and dump.
+// JSON for result files (summary.json, results.json, reports): nlohmann/json, keys in
+// insertion order, written so that a file is always valid JSON.
 #pragma once
 
-#include <cstdint>
-#include <map>
-#include <memory>
+#include <nlohmann/json.hpp>
+
 #include <string>
-#include <utility>
-#include <variant>
-#include <vector>
 
 namespace binocle {
 
-class Json {
-public:
-    using Array = std::vector<Json>;
-    using Object = std::vector<std::pair<std::string, Json>>; // keeps insertion order
+using Json = nlohmann::ordered_json;
 
-    Json() : v_(nullptr) {}
-    Json(std::nullptr_t) : v_(nullptr) {}
-    Json(bool b) : v_(b) {}
-    Json(int v) : v_(static_cast<double>(v)) {}
-    Json(int64_t v) : v_(static_cast<double>(v)) {}
-    Json(uint64_t v) : v_(static_cast<double>(v)) {}
-    Json(double v) : v_(v) {}
-    Json(const char *s) : v_(std::string(s)) {}
-    Json(std::string s) : v_(std::move(s)) {}
-    Json(Array a) : v_(std::move(a)) {}
-    Json(Object o) : v_(std::move(o)) {}
-
-    static Json object() { return Json(Object{}); }
-    static Json array() { return Json(Array{}); }
-
-    // Object: sets (or replaces) a member. Array: appends.
-    Json &set(const std::string &key, Json value);
-    Json &push(Json value);
-    // nullptr when absent / not an object.
-    const Json *get(const std::string &key) const;
-    bool isNumber() const { return std::holds_alternative<double>(v_); }
-    double number() const { return std::get<double>(v_); }
-
-    // Non-finite numbers become null (JSON has no NaN).
-    std::string dump(int indent = 2) const;
-
-private:
-    void dumpTo(std::string &out, int indent, int depth) const;
-    std::variant<std::nullptr_t, bool, double, std::string, Array, Object> v_;
-};
-
-std::string jsonEscape(const std::string &s);
+// Indented text with a final newline. Non-finite numbers are written as null (JSON has no
+// NaN) and invalid UTF-8 in strings is replaced by U+FFFD, so the file always parses.
+inline std::string dumpJson(const Json &j, int indent = 2) {
+    return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
 
 } // namespace binocle

@@ -5,6 +5,8 @@
 #include "config/rig_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/json.hpp"
+#include "core/progress.hpp"
 #include "method/design.hpp"
 #include "pipeline/pipeline.hpp"
 #include "report/chart.hpp"
@@ -13,10 +15,9 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <iostream>
 #include <set>
 #include <sstream>
-#include <unistd.h>
+#include <spdlog/spdlog.h>
 
 namespace fs = std::filesystem;
 
@@ -323,24 +324,7 @@ namespace {
 const std::vector<std::string> kMainMetrics = {"epsilon_x_percent", "epsilon_y_percent", "epsilon_z_percent",
                                                "eta_2d_percent", "eta_3d_percent"};
 
-struct Row {
-    const ExperimentTest *test = nullptr;
-    std::vector<std::pair<std::string, double>> values; // in column order
-    std::string status = "ok", error;
-    double get(const std::string &k) const {
-        for (const auto &[n, v] : values)
-            if (n == k) return v;
-        return NAN;
-    }
-    void put(const std::string &k, double v) {
-        for (auto &[n, x] : values)
-            if (n == k) {
-                x = v;
-                return;
-            }
-        values.emplace_back(k, v);
-    }
-};
+using Row = ExperimentRow;
 
 std::string csvCell(double v) {
     if (!std::isfinite(v)) return "";
@@ -348,27 +332,6 @@ std::string csvCell(double v) {
     std::snprintf(buf, sizeof buf, "%.6g", v);
     return buf;
 }
-
-class ProgressBar {
-public:
-    ProgressBar(bool on, size_t total) : on_(on), total_(total), tty_(::isatty(2) != 0) {}
-    void show(size_t done, const std::string &what) {
-        if (!on_) return;
-        const int width = 24;
-        const int filled = static_cast<int>(width * done / std::max<size_t>(1, total_));
-        std::string bar = "[" + std::string(filled, '#') + std::string(width - filled, '-') + "]";
-        std::cerr << (tty_ ? "\r\033[K" : "") << bar << " " << done << "/" << total_ << "  " << what << (tty_ ? "" : "\n")
-                  << std::flush;
-    }
-    ~ProgressBar() {
-        if (on_ && tty_) std::cerr << "\n";
-    }
-
-private:
-    bool on_;
-    size_t total_;
-    bool tty_;
-};
 
 std::string testLabel(const ExperimentTest &t) {
     std::ostringstream os;
@@ -381,9 +344,8 @@ std::string testLabel(const ExperimentTest &t) {
 // What produced the results, for the report: binocle's and each plugin's version.
 Json software(const PluginHost &host) {
     Json plugins = Json::array();
-    for (const auto &p : host.plugins())
-        plugins.push(Json::object().set("name", p.name).set("version", p.version).set("kind", kindName(p.kind)));
-    return Json::object().set("binocle", BINOCLE_VERSION).set("opencv", CV_VERSION).set("plugins", std::move(plugins));
+    for (const auto &p : host.plugins()) plugins.push_back({{"name", p.name}, {"version", p.version}, {"kind", kindName(p.kind)}});
+    return {{"binocle", BINOCLE_VERSION}, {"opencv", CV_VERSION}, {"plugins", std::move(plugins)}};
 }
 
 void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows, const PluginHost &host) {
@@ -396,32 +358,29 @@ void writeTables(const std::string &dir, const Experiment &e, const std::vector<
     csv += ",error\n";
     Json tests = Json::array();
     for (const auto &r : rows) {
-        csv += r.test->id + "," + r.status;
-        Json row = Json::object();
-        row.set("test", r.test->id);
-        row.set("status", r.status);
+        csv += r.test_id + "," + r.status;
+        Json row = {{"test", r.test_id}, {"status", r.status}};
         for (const auto &c : columns) {
             const double v = r.get(c);
             csv += "," + csvCell(v);
-            row.set(c, std::isfinite(v) ? Json(v) : Json(nullptr));
+            row[c] = std::isfinite(v) ? Json(v) : Json(nullptr);
         }
         std::string err = r.error;
         std::replace(err.begin(), err.end(), '"', '\'');
         csv += ",\"" + err + "\"\n";
-        if (!r.error.empty()) row.set("error", r.error);
-        tests.push(std::move(row));
+        if (!r.error.empty()) row["error"] = r.error;
+        tests.push_back(std::move(row));
     }
     writeFileAtomic((fs::path(dir) / "results.csv").string(), csv);
-    Json doc = Json::object();
-    doc.set("experiment", e.name);
-    doc.set("description", e.description);
-    doc.set("file", e.file);
-    doc.set("rig", e.rig_file);
-    doc.set("rig_yaml", yamlBlock(e.rig));
-    doc.set("software", software(host));
-    doc.set("units", Json::object().set("length", "mm").set("angle", "deg").set("errors_and_efficiencies", "%"));
-    doc.set("tests", std::move(tests));
-    writeFileAtomic((fs::path(dir) / "results.json").string(), doc.dump());
+    Json doc = {{"experiment", e.name},
+                {"description", e.description},
+                {"file", e.file},
+                {"rig", e.rig_file},
+                {"rig_yaml", yamlBlock(e.rig)},
+                {"software", software(host)},
+                {"units", {{"length", "mm"}, {"angle", "deg"}, {"errors_and_efficiencies", "%"}}},
+                {"tests", std::move(tests)}};
+    writeFileAtomic((fs::path(dir) / "results.json").string(), dumpJson(doc));
 }
 
 std::string mm(double v) { return num(v) + " mm"; }
@@ -442,7 +401,7 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
     for (const auto &spec : e.charts) {
         const bool any = std::any_of(rows.begin(), rows.end(), [&](const Row &r) { return std::isfinite(r.get(spec.metric)); });
         if (!any) {
-            std::cerr << "experiment: chart '" << spec.file << "' skipped: no test reported " << spec.metric << "\n";
+            spdlog::warn("experiment: chart '{}' skipped: no test reported {}", spec.file, spec.metric);
             continue;
         }
         const std::string stem = (fs::path(dir) / spec.file).string();
@@ -455,12 +414,12 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
             c.reference_lines = spec.reference_lines;
             std::vector<double> lenses;
             for (const auto &r : rows)
-                if (std::find(lenses.begin(), lenses.end(), r.test->geometry.focal_length_mm) == lenses.end())
-                    lenses.push_back(r.test->geometry.focal_length_mm);
+                if (std::find(lenses.begin(), lenses.end(), r.geometry.focal_length_mm) == lenses.end())
+                    lenses.push_back(r.geometry.focal_length_mm);
             std::sort(lenses.begin(), lenses.end());
             for (double f : lenses) c.series.push_back("f = " + mm(f));
             for (const auto &r : rows) {
-                const auto &g = r.test->geometry;
+                const auto &g = r.geometry;
                 std::string label = "R " + num(g.range_mm / 1000) + " m, B " + mm(g.baseline_mm);
                 if (g.inclination_deg != 0) label += ", θ " + num(g.inclination_deg) + "°";
                 auto it = std::find_if(c.groups.begin(), c.groups.end(), [&](const BarGroup &b) { return b.label == label; });
@@ -483,13 +442,13 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
             }
             std::vector<double> ranges;
             for (const auto &r : rows) {
-                const double R = r.test->geometry.range_mm;
+                const double R = r.geometry.range_mm;
                 if (std::find(ranges.begin(), ranges.end(), R) == ranges.end()) ranges.push_back(R);
             }
             for (double R : ranges) c.series.push_back("R = " + num(R / 1000) + " m");
             for (const auto &r : rows) {
-                const int s = static_cast<int>(std::find(ranges.begin(), ranges.end(), r.test->geometry.range_mm) - ranges.begin());
-                c.points.push_back({r.get(spec.x), r.get(spec.metric), r.test->id, s});
+                const int s = static_cast<int>(std::find(ranges.begin(), ranges.end(), r.geometry.range_mm) - ranges.begin());
+                c.points.push_back({r.get(spec.x), r.get(spec.metric), r.test_id, s});
             }
             writeChart(stem, c);
         }
@@ -498,7 +457,22 @@ void writeCharts(const std::string &dir, const Experiment &e, const std::vector<
 
 } // namespace
 
-Json runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
+double ExperimentRow::get(const std::string &column) const {
+    for (const auto &[n, v] : values)
+        if (n == column) return v;
+    return NAN;
+}
+
+void ExperimentRow::put(const std::string &column, double value) {
+    for (auto &[n, x] : values)
+        if (n == column) {
+            x = value;
+            return;
+        }
+    values.emplace_back(column, value);
+}
+
+ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options) {
     if (options.out_dir.empty()) throw Error("experiment: an output folder is needed (--out DIR)");
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
@@ -510,13 +484,14 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
     if (selected.empty()) throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
 
     std::vector<Row> rows;
-    ProgressBar bar(options.progress, selected.size());
+    Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
     const auto start = std::chrono::steady_clock::now();
     for (size_t i = 0; i < selected.size(); ++i) {
         const ExperimentTest &t = *selected[i];
-        bar.show(i, testLabel(t));
+        progress.update(static_cast<int64_t>(i), testLabel(t));
         Row row;
-        row.test = &t;
+        row.test_id = t.id;
+        row.geometry = t.geometry;
         const auto &g = t.geometry;
         row.put("baseline_mm", g.baseline_mm);
         row.put("focal_length_mm", g.focal_length_mm);
@@ -580,21 +555,20 @@ Json runExperiment(const Experiment &e, const PluginHost &host, const Experiment
         } catch (const std::exception &x) {
             row.status = "failed";
             row.error = x.what();
-            std::cerr << (::isatty(2) ? "\n" : "") << "experiment: " << testLabel(t) << " failed: " << x.what() << "\n";
+            spdlog::error("experiment: {} failed: {}", testLabel(t), x.what());
         }
         row.put("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         rows.push_back(std::move(row));
         // Rewritten after every test: an interrupted experiment keeps what it measured.
         writeTables(options.out_dir, e, rows, host);
     }
-    bar.show(selected.size(), "done");
+    progress.update(static_cast<int64_t>(selected.size()), "done");
+    progress.finish();
     writeCharts(options.out_dir, e, rows);
-    Json result = Json::object();
-    result.set("experiment", e.name);
-    result.set("tests", static_cast<int64_t>(rows.size()));
-    const auto failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
-    result.set("failed", static_cast<int64_t>(failed));
-    result.set("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ExperimentResult result;
+    result.failed = std::count_if(rows.begin(), rows.end(), [](const Row &r) { return r.status != "ok"; });
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.rows = std::move(rows);
     return result;
 }
 

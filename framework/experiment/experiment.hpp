@@ -5,7 +5,6 @@
 // results is kept; at the end come results.csv/json and charts.
 #pragma once
 
-#include "core/json.hpp"
 #include "host/plugin_host.hpp"
 
 #include <functional>
@@ -75,10 +74,29 @@ struct ExperimentOptions {
     std::vector<std::string> only; // test ids to run; empty = all
 };
 
+// One row of results.csv / results.json: a test's variables and every figure measured.
+struct ExperimentRow {
+    std::string test_id;
+    TestGeometry geometry;
+    std::string status = "ok"; // or "failed", with `error`
+    std::string error;
+    std::vector<std::pair<std::string, double>> values; // column -> value, in column order (NaN: none)
+
+    // NaN when the column is absent.
+    double get(const std::string &column) const;
+    void put(const std::string &column, double value);
+};
+
+struct ExperimentResult {
+    std::vector<ExperimentRow> rows; // one per test run, in order
+    int64_t failed = 0;
+    double seconds = 0;
+};
+
 // Runs every test and writes results.csv, results.json, charts and per-test outputs
-// into out_dir/test_<id>/. Returns the results (also in results.json). A test whose
-// pipeline fails is recorded with its error and the others still run; the caller
-// decides the exit status from "failed" in the result.
-Json runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options);
+// into out_dir/test_<id>/. Returns the rows it wrote. A test whose pipeline fails is
+// recorded with its error and the others still run; the caller decides the exit status
+// from `failed`.
+ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options);
 
 } // namespace binocle

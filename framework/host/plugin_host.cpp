@@ -2,6 +2,8 @@
 // The plugin host: search path, loading with Boost.DLL, ABI checks, instance wrappers.
 #include "host/plugin_host.hpp"
 
+#include "core/log.hpp"
+
 #include <algorithm>
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
@@ -363,9 +365,7 @@ void hostLog(void *ctx, int32_t level, const char *message) {
         auto *c = static_cast<SinkContext *>(ctx);
         std::string msg = message ? message : "";
         if (c->sink.log) return c->sink.log(level, msg);
-        if (level < BINOCLE_LOG_INFO) return;
-        static const char *names[] = {"debug", "info", "warning", "error"};
-        std::cerr << "[" << c->plugin << "] " << names[std::clamp(level, 0, 3)] << ": " << msg << "\n";
+        logFromPlugin(c->plugin, level, msg);
     } catch (...) {
     }
 }

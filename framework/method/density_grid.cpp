@@ -2,6 +2,8 @@
 // Density grids (top, front, side views) and the solid objects localised in them.
 #include "method/density_grid.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -333,22 +335,25 @@ std::vector<LocalisedObject> localiseObjects(const CloudView &cloud, const GridS
 }
 
 std::string objectsJson(const std::vector<LocalisedObject> &objects) {
-    std::string out = "[";
-    char buf[640];
-    for (size_t k = 0; k < objects.size(); ++k) {
-        const LocalisedObject &o = objects[k];
-        std::snprintf(buf, sizeof buf,
-                      "%s\n  {\"id\": %d, \"points\": %lld, \"cells\": %d, \"center_x_mm\": %.1f, \"range_mm\": %.1f, "
-                      "\"centroid_mm\": [%.1f, %.1f], \"x_mm\": [%.1f, %.1f], \"y_mm\": [%.1f, %.1f], "
-                      "\"z_mm\": [%.1f, %.1f], \"width_mm\": %.1f, \"depth_mm\": %.1f, \"height_mm\": %.1f, "
-                      "\"on_ground\": %s}",
-                      k ? "," : "", o.id, static_cast<long long>(o.points), o.cells, o.center_x_mm, o.range_mm,
-                      o.centroid_x_mm, o.centroid_y_mm, o.x_min_mm, o.x_max_mm, o.y_min_mm, o.y_max_mm, o.z_min_mm,
-                      o.z_max_mm, o.width_mm, o.depth_mm, o.height_mm, o.on_ground ? "true" : "false");
-        out += buf;
+    // Millimetres to 0.1 mm: finer digits would only be noise of the grid.
+    auto mm = [](double v) { return std::round(v * 10.0) / 10.0; };
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const LocalisedObject &o : objects) {
+        list.push_back({{"id", o.id},
+                        {"points", o.points},
+                        {"cells", o.cells},
+                        {"center_x_mm", mm(o.center_x_mm)},
+                        {"range_mm", mm(o.range_mm)},
+                        {"centroid_mm", {mm(o.centroid_x_mm), mm(o.centroid_y_mm)}},
+                        {"x_mm", {mm(o.x_min_mm), mm(o.x_max_mm)}},
+                        {"y_mm", {mm(o.y_min_mm), mm(o.y_max_mm)}},
+                        {"z_mm", {mm(o.z_min_mm), mm(o.z_max_mm)}},
+                        {"width_mm", mm(o.width_mm)},
+                        {"depth_mm", mm(o.depth_mm)},
+                        {"height_mm", mm(o.height_mm)},
+                        {"on_ground", o.on_ground}});
     }
-    out += objects.empty() ? "]" : "\n]";
-    return out;
+    return list.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 } // namespace binocle::method

@@ -6,15 +6,14 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
+#include "core/progress.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -35,11 +34,11 @@ std::unique_ptr<Pipeline::EvaluatorSlot> Pipeline::makeEvaluator(const PluginBlo
     sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
         if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
         if (!raw->target) return;
-        raw->target->set(name, value);
-        if (!unit.empty()) raw->target->set(name + "_unit", unit);
+        (*raw->target)[name] = value;
+        if (!unit.empty()) (*raw->target)[name + "_unit"] = unit;
     };
     sink.text = [raw](const std::string &name, const std::string &text) {
-        if (raw->target) raw->target->set(name, text);
+        if (raw->target) (*raw->target)[name] = text;
     };
     slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
     return slot;
@@ -201,7 +200,7 @@ FrameResult Pipeline::process(const LentFrame &frame) {
             }
             slot->target = nullptr;
             slot->flat = nullptr;
-            r.metrics.set(slot->name, std::move(figures));
+            r.metrics[slot->name] = std::move(figures);
         }
     }
     stage("evaluators");
@@ -223,37 +222,6 @@ void writeFrameOutputs(const FrameResult &r, const OutputOptions &o, const std::
     if (o.cloud_ply) writePly((d / ("cloud_" + std::string(stem) + ".ply")).string(), r.cloud);
 }
 
-namespace {
-
-class Progress {
-public:
-    explicit Progress(bool enabled, int64_t total) : enabled_(enabled), total_(total), tty_(::isatty(2) != 0) {}
-    void update(int64_t done, double fps) {
-        if (!enabled_) return;
-        const auto now = std::chrono::steady_clock::now();
-        if (!tty_ && done > 1 && now - last_ < std::chrono::seconds(2)) return;
-        last_ = now;
-        char buf[128];
-        if (total_ > 0)
-            std::snprintf(buf, sizeof buf, "frame %lld/%lld  %.1f fps", static_cast<long long>(done), static_cast<long long>(total_), fps);
-        else
-            std::snprintf(buf, sizeof buf, "frame %lld  %.1f fps", static_cast<long long>(done), fps);
-        std::cerr << (tty_ ? "\r" : "") << buf << (tty_ ? "" : "\n") << std::flush;
-        printed_ = true;
-    }
-    ~Progress() {
-        if (printed_ && tty_) std::cerr << "\n";
-    }
-
-private:
-    bool enabled_;
-    int64_t total_;
-    bool tty_;
-    bool printed_ = false;
-    std::chrono::steady_clock::time_point last_{};
-};
-
-} // namespace
 
 Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
     outDir_ = options.out_dir;
@@ -262,42 +230,38 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
         fs::create_directories(outDir_, ec);
         if (ec) throw Error("--out " + outDir_ + ": cannot create the folder: " + ec.message());
     }
-    Json summary = Json::object();
-    summary.set("rig", rig_.file);
-    summary.set("name", rig_.name);
-    summary.set("source", rig_.source.plugin);
-    summary.set("matcher", rig_.matcher.plugin);
-    summary.set("units", Json::object().set("length", "mm").set("disparity", "px").set("disparity_png_scale", 256));
+    Json summary = {{"rig", rig_.file},
+                    {"name", rig_.name},
+                    {"source", rig_.source.plugin},
+                    {"matcher", rig_.matcher.plugin},
+                    {"units", {{"length", "mm"}, {"disparity", "px"}, {"disparity_png_scale", 256}}}};
     Json frames = Json::array();
     const auto start = std::chrono::steady_clock::now();
     int64_t count = 0;
     std::string failure;
     auto writeSummary = [&]() {
-        summary.set("frames", frames);
+        summary["frames"] = frames;
         if (outDir_.empty()) return;
-        writeFileAtomic((fs::path(outDir_) / "summary.json").string(), summary.dump());
+        writeFileAtomic((fs::path(outDir_) / "summary.json").string(), dumpJson(summary));
     };
     try {
         source_->start();
         sourceStarted_ = true;
-        Progress progress(options.progress, options.max_frames);
+        Progress progress(options.progress, "frame", options.max_frames);
         while (options.max_frames < 0 || count < options.max_frames) {
             if (options.between_frames && !options.between_frames()) break;
             std::unique_ptr<LentFrame> frame = source_->grab(options.grab_timeout_ms);
             if (!frame) break;
             FrameResult r = process(*frame);
             if (!outDir_.empty()) writeFrameOutputs(r, rig_.outputs, outDir_);
-            Json f = Json::object();
-            f.set("sequence", r.sequence);
-            f.set("valid_pixel_ratio", r.valid_pixel_ratio);
-            f.set("points", static_cast<uint64_t>(r.cloud.size()));
-            f.set("seconds", r.seconds);
-            f.set("metrics", r.metrics);
-            frames.push(std::move(f));
+            frames.push_back({{"sequence", r.sequence},
+                              {"valid_pixel_ratio", r.valid_pixel_ratio},
+                              {"points", r.cloud.size()},
+                              {"seconds", r.seconds},
+                              {"metrics", r.metrics}});
             if (onFrame) onFrame(r);
             ++count;
-            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            progress.update(count, elapsed > 0 ? count / elapsed : 0.0);
+            progress.update(count);
         }
         Json totals = Json::object();
         for (auto &slot : evaluators_) {
@@ -305,25 +269,24 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
             slot->target = &figures;
             slot->evaluator->finish();
             slot->target = nullptr;
-            totals.set(slot->name, std::move(figures));
+            totals[slot->name] = std::move(figures);
         }
-        summary.set("metrics", totals);
+        summary["metrics"] = totals;
         const std::string stats = source_->statistics();
-        if (!stats.empty()) summary.set("source_statistics", stats);
+        if (!stats.empty()) summary["source_statistics"] = stats;
     } catch (const std::exception &e) {
         failure = e.what();
     }
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    summary.set("frame_count", count);
-    summary.set("seconds", elapsed);
-    summary.set("status", failure.empty() ? "ok" : "failed");
-    if (!failure.empty()) summary.set("error", failure);
+    summary["frame_count"] = count;
+    summary["seconds"] = elapsed;
+    summary["status"] = failure.empty() ? "ok" : "failed";
+    if (!failure.empty()) summary["error"] = failure;
     if (calibrationReady_) {
-        summary.set("calibration", Json::object()
-                                       .set("baseline_mm", calibration_.baselineMm())
-                                       .set("focal_length_px", calibration_.focalLengthPx())
-                                       .set("image_width", calibration_.image_size.width)
-                                       .set("image_height", calibration_.image_size.height));
+        summary["calibration"] = {{"baseline_mm", calibration_.baselineMm()},
+                                  {"focal_length_px", calibration_.focalLengthPx()},
+                                  {"image_width", calibration_.image_size.width},
+                                  {"image_height", calibration_.image_size.height}};
     }
     writeSummary();
     if (!failure.empty()) throw Error(failure);

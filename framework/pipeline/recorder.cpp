@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/progress.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,7 +13,6 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
-#include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
@@ -136,8 +136,7 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
 
     RecordResult result;
     const auto begin = std::chrono::steady_clock::now();
-    auto lastReport = begin;
-    const bool tty = ::isatty(2) != 0;
+    Progress progress(options.progress, "frame", options.max_frames);
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); };
     try {
         source.start();
@@ -148,19 +147,13 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
             writer.append(*frame);
             frame.reset(); // give the buffer back before waiting for the next one
             if (onFrame) onFrame(writer.frameCount());
-            const auto now = std::chrono::steady_clock::now();
-            if (options.progress && (tty || now - lastReport > std::chrono::seconds(2))) {
-                lastReport = now;
-                const double s = elapsed();
-                std::fprintf(stderr, "%srecorded %lld frame(s), %.1f fps%s", tty ? "\r" : "",
-                              static_cast<long long>(writer.frameCount()), s > 0 ? writer.frameCount() / s : 0.0, tty ? "" : "\n");
-            }
+            progress.update(writer.frameCount(), "recorded");
         }
         source.stop();
     } catch (const std::exception &e) {
         result.error = e.what();
     }
-    if (options.progress && tty && writer.frameCount() > 0) std::fprintf(stderr, "\n");
+    progress.finish();
     try {
         result.source_statistics = source.statistics();
     } catch (const std::exception &) {

@@ -70,8 +70,7 @@ FrameProducts copyFrame(const FrameResult &r) {
     p.result.figures = r.figures;
     p.result.seconds = r.seconds;
     p.result.stage_seconds = r.stage_seconds;
-    p.metrics = OJson::parse(r.metrics.dump(), nullptr, false);
-    if (p.metrics.is_discarded()) p.metrics = OJson::object();
+    p.metrics = r.metrics.is_object() ? r.metrics : OJson::object();
     return p;
 }
 

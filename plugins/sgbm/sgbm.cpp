@@ -31,7 +31,7 @@ public:
         });
     }
 
-    SemiGlobalMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &)
+    SemiGlobalMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host)
         : OpenCvMatcher("sgbm", p, parameters(), 1) {
         const int block = static_cast<int>(p.integer("block_size"));
         const Penalty p1 = penalty(p, "p1", 8, block);
@@ -44,6 +44,7 @@ public:
         stereo_->setP1(p1.value);
         stereo_->setP2(p2.value);
         stereo_->setMode(modeOf(p.string("mode")));
+        host.debug("block_size " + std::to_string(block) + ", p1 " + p1.text() + ", p2 " + p2.text() + ", mode " + p.string("mode"));
     }
 
 private:

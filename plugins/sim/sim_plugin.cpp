@@ -100,7 +100,7 @@ public:
         };
     }
 
-    SimSource(const sdk::Params &p, sdk::Host & /*host*/) {
+    SimSource(const sdk::Params &p, sdk::Host &host) : host_(host) {
         checkParameters(p, parameters(), "sim");
         sim::RigSettings rig;
         rig.image_width = static_cast<int>(p.integer("image_width"));
@@ -185,6 +185,7 @@ public:
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
         renderMsTotal_ += ms;
         renderMsLast_ = ms;
+        host_.debug("frame " + std::to_string(index) + " rendered in " + std::to_string(ms) + " ms");
         return frame;
     }
 
@@ -216,6 +217,7 @@ private:
     int64_t periodNs_ = 0;
     uint64_t next_ = 0;
     double renderMsTotal_ = 0, renderMsLast_ = 0;
+    sdk::Host host_; // for debug lines (the host outlives the instance)
 };
 
 } // namespace binocle::plugins

@@ -158,20 +158,21 @@ TEST(CalibrateCli, BadInputFailsClearlyAndWritesNothing) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("no image pairs found"), std::string::npos) << r.output;
 
+    // Usage mistakes: exit status 2.
     r = runCommand(cli + "--pairs " + pairs.str() + " --board 9by6 --square-mm 25");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find("--board '9by6': expected COLSxROWS"), std::string::npos) << r.output;
 
     r = runCommand(cli + "--pairs " + pairs.str() + " --board 9x6");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("missing --square-mm"), std::string::npos) << r.output;
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--square-mm is required"), std::string::npos) << r.output;
 
     r = runCommand(cli + "--pairs /nonexistent/pairs --board 9x6 --square-mm 25");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("--pairs /nonexistent/pairs: not a folder"), std::string::npos) << r.output;
 
     r = runCommand(cli + "--board 9x6 --square-mm 25");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find("expected a rig file"), std::string::npos) << r.output;
 
     // Too few usable pairs: the reasons, and no calibration.

@@ -54,7 +54,7 @@ TEST(CalibrationFiles, WritesTheSetBesideTheCalibration) {
     EXPECT_EQ(f.right_info, dir.str("sub/calib_B150_f8_right.yaml"));
     EXPECT_EQ(f.report, dir.str("sub/calib_B150_f8_report.json"));
     const StereoCalibration c = StereoCalibration::ideal({320, 240}, 400, 150);
-    writeCalibrationFiles(f, c, Json::object().set("rms_px", 0.1));
+    writeCalibrationFiles(f, c, Json{{"rms_px", 0.1}});
     for (const auto &p : {f.calibration, f.left_info, f.right_info, f.report}) EXPECT_TRUE(std::filesystem::exists(p)) << p;
     EXPECT_NEAR(StereoCalibration::load(f.calibration).baselineMm(), 150, 1e-9);
     size_t entries = 0;

@@ -2,6 +2,7 @@
 // The `binocle` command end to end: help, plugins, and a run on the real opencv-doc
 // pair checked against its ground-truth disparity.
 #include "common/test_util.hpp"
+#include "core/atomic_file.hpp"
 #include "core/cloud.hpp"
 #include "core/image_io.hpp"
 
@@ -84,6 +85,103 @@ TEST(Cli, MisspeltKeyOnTheCommandLineIsReported) {
     auto r = runCli("run " BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml --set matcher.num_disparity=64");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("did you mean 'num_disparities'"), std::string::npos) << r.output;
+}
+
+const std::string kAloe = BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml";
+const std::string kSim = BINOCLE_SOURCE_DIR "/configs/rigs/sim-videre.yaml";
+
+TEST(Cli, UnknownOptionsAreUsageErrorsNamingTheOption) {
+    auto r = runCli("run " + kAloe + " --bogus x");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("unknown option '--bogus'"), std::string::npos) << r.output;
+
+    r = runCli("run " + kAloe + " --frame 2");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("unknown option '--frame'; did you mean '--frames'?"), std::string::npos) << r.output;
+
+    r = runCli("run " + kAloe + " --frame=2");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("did you mean '--frames'?"), std::string::npos) << r.output;
+
+    r = runCli("run " + kAloe + " " + kAloe);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("unexpected argument"), std::string::npos) << r.output;
+
+    r = runCli("plugins --verbos");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("did you mean '--verbose'?"), std::string::npos) << r.output;
+
+    r = runCli("experment");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("did you mean 'experiment'?"), std::string::npos) << r.output;
+}
+
+TEST(Cli, NumericOptionsAreValidated) {
+    for (const char *bad : {"--frames -5", "--frames 0", "--frames two", "--frames 1.5"}) {
+        auto r = runCli("run " + kAloe + " " + bad);
+        EXPECT_EQ(r.exit_code, 2) << bad << "\n" << r.output;
+        EXPECT_NE(r.output.find("--frames"), std::string::npos) << r.output;
+    }
+    auto r = runCli("design --range 6000 --pixel-pitch-um -3");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--pixel-pitch-um"), std::string::npos) << r.output;
+}
+
+TEST(Cli, HelpAndVersionComeFromTheParser) {
+    auto r = runCli("run --help");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char *option : {"--frames", "--out", "--set", "--quiet", "--log-level", "--log-file"})
+        EXPECT_NE(r.output.find(option), std::string::npos) << option << "\n" << r.output;
+    r = runCli("--version");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("binocle 0."), std::string::npos) << r.output;
+    r = runCli("");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("usage: binocle"), std::string::npos) << r.output;
+}
+
+TEST(Cli, PluginDebugLinesAreTaggedAndShownAtDebugOnly) {
+    binocle::test::TempDir dir;
+    auto r = runCli("--log-level debug run " + kSim + " --frames 1 --quiet --log-file " + dir.str("log.txt"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("debug: [sim] frame 0 rendered in"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("debug: [sgbm] block_size"), std::string::npos) << r.output;
+    const std::string log = binocle::readTextFile(dir.str("log.txt"));
+    EXPECT_NE(log.find("[debug] [sim] frame 0 rendered in"), std::string::npos) << log;
+
+    // The same through the environment, and the option after the command.
+    r = binocle::test::runCommand("BINOCLE_LOG_LEVEL=debug BINOCLE_PLUGIN_PATH='" BINOCLE_BUILD_PLUGIN_DIR "' '" BINOCLE_CLI
+                                  "' run " + kSim + " --frames 1 --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("[sim] frame 0 rendered"), std::string::npos) << r.output;
+
+    r = runCli("run " + kSim + " --frames 1 --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("[sim]"), std::string::npos) << r.output; // info by default
+    r = runCli("run " + kSim + " --frames 1 --quiet --log-level warn");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("frame(s) of rig"), std::string::npos) << r.output;
+
+    r = runCli("--log-level loud plugins");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--log-level 'loud'"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BashCompletionKnowsCommandsAndOptions) {
+    binocle::test::TempDir dir;
+    auto r = runCli("completion bash > " + dir.str("binocle.bash"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // Completes like bash would: the words typed so far, then the function.
+    auto complete = [&](const std::string &words) {
+        const std::string script = "source " + dir.str("binocle.bash") + "; COMP_WORDS=(" + words +
+                                   "); COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); _binocle; echo \"${COMPREPLY[*]}\"";
+        return binocle::test::runCommand("bash -c '" + script + "'").output;
+    };
+    EXPECT_NE(complete("binocle exp").find("experiment"), std::string::npos);
+    EXPECT_NE(complete("binocle run rig.yaml --fr").find("--frames"), std::string::npos) << complete("binocle run rig.yaml --fr");
+    EXPECT_NE(complete("binocle --log-level d").find("debug"), std::string::npos);
+    EXPECT_EQ(complete("binocle run rig.yaml --fr").find("--frames-"), std::string::npos);
+    EXPECT_EQ(runCli("completion zsh").exit_code, 2);
 }
 
 } // namespace

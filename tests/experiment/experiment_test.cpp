@@ -106,9 +106,9 @@ TEST(Design, RanksByFormFactorAndRefusesBadInput) {
     ASSERT_NE(first, std::string::npos) << r.output;
     EXPECT_NE(r.output.substr(first, 40).find("150     8.0    2.00"), std::string::npos) << r.output;
     EXPECT_NE(readTextFile(dir.str("design.json")).find("\"form_factor\": 2"), std::string::npos);
-    EXPECT_EQ(runCli("design").exit_code, 1);
+    EXPECT_EQ(runCli("design").exit_code, 2); // usage: no target
     auto bad = runCli("design --range 6000 --lenses 8,x");
-    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.output.find("'x' is not a number"), std::string::npos) << bad.output;
 }
 

@@ -193,12 +193,13 @@ TEST(Record, CommandLineErrorsSayWhatIsWrong) {
     TempDir dir;
     writeColourPairs(dir, 1);
     binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir));
+    // Usage mistakes: exit status 2, the option named.
     auto r = binocle::test::runCli("record " + dir.str("rig.yaml"));
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.output.find("missing --out DIR"), std::string::npos) << r.output;
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("--out is required"), std::string::npos) << r.output;
     r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("x") + " --frames 0");
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.output.find("--frames = 0"), std::string::npos) << r.output;
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("--frames: '0': expected a whole number >= 1"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir.str("x")));
 }
 

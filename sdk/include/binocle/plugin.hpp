@@ -121,6 +121,8 @@ public:
     void log(int32_t level, const std::string &msg) const {
         if (h_ && h_->log) h_->log(h_->context, level, msg.c_str());
     }
+    // Shown by `binocle --log-level debug ...`, tagged with the plugin's name.
+    void debug(const std::string &msg) const { log(BINOCLE_LOG_DEBUG, msg); }
     void info(const std::string &msg) const { log(BINOCLE_LOG_INFO, msg); }
     void warning(const std::string &msg) const { log(BINOCLE_LOG_WARNING, msg); }
     void metric(const std::string &name, double value, const std::string &unit = "") const {

@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: MIT
+// The `binocle` command line as one CLI11 app: registry, global options, shared helpers.
+#include "cli/command.hpp"
+
+#include <binocle/abi.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+namespace binocle::cli {
+
+namespace {
+
+std::map<std::string, Command> &registry() {
+    static std::map<std::string, Command> r;
+    return r;
+}
+
+// CLI11's help, with the lower-case "usage:" of the rest of the project's messages.
+class Formatter : public CLI::Formatter {
+public:
+    std::string make_usage(const CLI::App *app, std::string name) const override {
+        std::string u = CLI::Formatter::make_usage(app, std::move(name));
+        if (u.rfind("Usage:", 0) == 0) u[0] = 'u';
+        return u;
+    }
+};
+
+} // namespace
+
+const std::map<std::string, Command> &commands() { return registry(); }
+
+Register::Register(Command c) { registry()[c.name] = std::move(c); }
+
+std::unique_ptr<CLI::App> makeApp(std::map<const CLI::App *, Runner> &runners) {
+    auto app = std::make_unique<CLI::App>("binocle: stereo camera design and processing framework", "binocle");
+    app->formatter(std::make_shared<Formatter>());
+    app->set_version_flag("--version", std::string("binocle ") + BINOCLE_VERSION + " (plugin ABI " +
+                                           std::to_string(BINOCLE_ABI_VERSION) + ", API " +
+                                           std::to_string(BINOCLE_API_VERSION) + ")");
+    // Global options are defined in main (they need its state); here what the subcommands
+    // inherit: unknown arguments are collected (main names them, with a suggestion) and
+    // options of the top level are accepted after the command too.
+    app->allow_extras();
+    app->fallthrough();
+    app->require_subcommand(0, 1);
+    const std::string common =
+        "Exit status: 0 ok, 1 the run failed, 2 wrong usage (unknown option, bad value).\n"
+        "Global options, before or after the command: --log-level LEVEL (trace, debug, info, warn,\n"
+        "error, off; default info or $BINOCLE_LOG_LEVEL), --log-file FILE, --version.\n";
+    app->footer(common + "Run `binocle <command> --help` for a command's options.\n"
+                         "Plugins are searched in $BINOCLE_PLUGIN_PATH, the install prefix and the build tree.\n");
+    for (const auto &[name, c] : commands()) {
+        CLI::App *sub = app->add_subcommand(name, c.summary);
+        sub->footer((c.details.empty() ? "" : c.details + "\n\n") + common);
+        runners[sub] = c.define(*sub);
+    }
+    return app;
+}
+
+void addRigArgs(CLI::App &app, RigArgs &args, bool required) {
+    auto *rig = app.add_option("rig", args.file, "the rig file (YAML)")->type_name("RIG.yaml");
+    if (required) rig->required();
+    app.add_option("--set", args.overrides, "override a value of the rig, e.g. --set matcher.num_disparities=128 (repeatable)")
+        ->type_name("KEY=VALUE")
+        ->allow_extra_args(false);
+}
+
+RigConfig loadRig(const RigArgs &args, const PluginHost &host) {
+    std::vector<Override> overrides;
+    for (const auto &s : args.overrides) overrides.push_back(Override::parse(s));
+    return loadRig(args.file, overrides, host);
+}
+
+CLI::Validator atLeast(long long min) {
+    return CLI::Validator(
+        [min](std::string &text) -> std::string {
+            errno = 0;
+            char *end = nullptr;
+            const long long v = std::strtoll(text.c_str(), &end, 10);
+            if (text.empty() || *end != '\0' || errno == ERANGE || v < min)
+                return "'" + text + "': expected a whole number >= " + std::to_string(min);
+            return "";
+        },
+        "");
+}
+
+CLI::Validator positiveNumber() {
+    return CLI::Validator(
+        [](std::string &text) -> std::string {
+            char *end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0)) return "'" + text + "': expected a number > 0";
+            return "";
+        },
+        "");
+}
+
+std::string dataFile(const std::string &relative) {
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const auto installed = exe.parent_path().parent_path() / BINOCLE_DATA_INSTALL_DIR / relative;
+    if (!ec && std::filesystem::exists(installed)) return installed.string();
+    return (std::filesystem::path(BINOCLE_SOURCE_DIR) / relative).string();
+}
+
+} // namespace binocle::cli
