@@ -188,13 +188,28 @@ struct Pipeline::RunState {
     }
 };
 
+namespace {
+
+// For display only: a matcher that cannot say its range still runs (its failures are
+// the run's to report), the range is then {0, 0}.
+std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
+    try {
+        return m.disparityRange();
+    } catch (const std::exception &e) {
+        spdlog::debug("matcher disparity range: {}", e.what());
+        return {0, 0};
+    }
+}
+
+} // namespace
+
 Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
     source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
     for (int i = 0; i < rig.runtime.matcher_instances; ++i)
         matchers_.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
     for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
     for (const auto &e : rig.evaluators) evaluators_.push_back(makeEvaluator(e));
-    disparityRange_ = matchers_.front()->disparityRange();
+    disparityRange_ = askDisparityRange(*matchers_.front());
 }
 
 std::string Pipeline::sourceStatistics() const {
@@ -255,7 +270,7 @@ void Pipeline::reconfigure(const RigConfig &rig) {
     if (!sameBlock(rig.matcher, rig_.matcher))
         for (size_t i = 0; i < matchers_.size(); ++i)
             matchers.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
-    const std::pair<int32_t, int32_t> range = matchers.empty() ? disparityRange_ : matchers.front()->disparityRange();
+    const std::pair<int32_t, int32_t> range = matchers.empty() ? disparityRange_ : askDisparityRange(*matchers.front());
     for (size_t i = 0; i < rig.transforms.size(); ++i)
         if (i >= rig_.transforms.size() || !sameBlock(rig.transforms[i], rig_.transforms[i]))
             transforms[i] = std::make_unique<CloudTransform>(*rig.transforms[i].record, rig.transforms[i].params);
