@@ -3,6 +3,7 @@
 #include "cli/command.hpp"
 #include "core/error.hpp"
 #include "experiment/experiment.hpp"
+#include "report/html_report.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -15,7 +16,7 @@ namespace {
 struct ExperimentArgs {
     std::string file, out, shard;
     std::vector<std::string> tests, set;
-    bool check = false, quiet = false;
+    bool check = false, quiet = false, report = false;
     std::vector<std::string> merge; // `experiment merge OUT DIR...`
 };
 
@@ -49,6 +50,7 @@ int experiment(const ExperimentArgs &args) {
     const ExperimentResult result = runExperiment(e, host, options);
     spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",
                  e.name, result.rows.size(), static_cast<int>(result.seconds), result.failed, options.out_dir);
+    if (args.report) spdlog::info("report: {}", report::writeExperimentReport(options.out_dir));
     return result.failed ? 1 : 0;
 }
 
@@ -90,6 +92,7 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
                       ->allow_extra_args(false);
                   app.add_flag("--check", args->check, "validate the file and stop");
                   app.add_flag("--quiet", args->quiet, "no progress display");
+                  app.add_flag("--report", args->report, "also write DIR/report.html (as `binocle report DIR`)");
                   return [args] { return experiment(*args); };
               }}};
 

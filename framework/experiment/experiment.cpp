@@ -205,6 +205,12 @@ void checkGeometry(const Experiment &e, const ExperimentTest &t, const Reader &r
                          " .. " + num(e.baseline_max_mm) + " mm");
 }
 
+std::string yamlBlock(const YAML::Node &n) {
+    YAML::Emitter em;
+    em << n;
+    return em.c_str();
+}
+
 std::string yamlText(const YAML::Node &n) {
     YAML::Emitter em;
     em << YAML::Flow << n;
@@ -714,9 +720,17 @@ OJson predictorRho(const std::vector<Row> &rows) {
     return out;
 }
 
+// What produced the results, for the report: binocle's and each plugin's version.
+OJson software(const PluginHost &host) {
+    OJson plugins = OJson::array();
+    for (const auto &p : host.plugins()) plugins.push_back({{"name", p.name}, {"version", p.version}, {"kind", kindName(p.kind)}});
+    return {{"binocle", BINOCLE_VERSION}, {"opencv", CV_VERSION}, {"plugins", std::move(plugins)}};
+}
+
 struct TablesMeta {
     std::vector<std::string> test_ids; // every test of the experiment, in file order
     int shard_index = 1, shard_count = 1;
+    OJson software; // software(host)
 };
 
 void writeTables(const std::string &dir, const Experiment &e, const std::vector<Row> &rows, const TablesMeta &meta) {
@@ -739,8 +753,11 @@ void writeTables(const std::string &dir, const Experiment &e, const std::vector<
     writeFileAtomic((fs::path(dir) / "results.csv").string(), csv);
     OJson doc = OJson::object();
     doc["experiment"] = e.name;
+    doc["description"] = e.description;
     doc["file"] = e.file;
     doc["rig"] = e.rig_file;
+    doc["rig_yaml"] = yamlBlock(e.rig);
+    doc["software"] = meta.software;
     doc["overrides"] = e.overrides;
     doc["calibration"] = e.calibration;
     doc["test_ids"] = meta.test_ids;
@@ -1030,8 +1047,9 @@ ExperimentResult resultOf(const std::vector<Row> &rows) {
     return result;
 }
 
-TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount) {
+TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount, const PluginHost &host) {
     TablesMeta m;
+    m.software = software(host);
     for (const auto &t : e.tests) m.test_ids.push_back(t.id);
     m.shard_index = shardIndex;
     m.shard_count = shardCount;
@@ -1099,7 +1117,7 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
                         " tests: run into a new folder and join them with `binocle experiment merge OUT DIR...`, "
                         "or run every test");
     }
-    const TablesMeta meta = metaOf(e, options.shard_index, options.shard_count);
+    const TablesMeta meta = metaOf(e, options.shard_index, options.shard_count, host);
 
     std::vector<Row> rows;
     Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
@@ -1186,7 +1204,7 @@ ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::v
             fs::copy(from, to, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
             if (ec) throw Error("experiment merge: copying " + from.string() + " to " + to.string() + ": " + ec.message());
         }
-    writeTables(out_dir, e, rows, metaOf(e, 1, 1));
+    writeTables(out_dir, e, rows, metaOf(e, 1, 1, host));
     writeCharts(out_dir, e, rows);
     return resultOf(rows);
 }

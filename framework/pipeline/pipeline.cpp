@@ -14,6 +14,7 @@
 #include "pipeline/stage_queue.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
@@ -151,6 +152,11 @@ struct Pipeline::RunState {
     std::condition_variable poolReady;
     std::vector<std::unique_ptr<Job>> pool;
 
+    // Frames through the writer (done or failed), for between_frames' drain.
+    std::mutex doneMutex;
+    std::condition_variable doneCv;
+    int64_t finished = 0;
+
     std::atomic<bool> aborted{false};
     std::mutex failMutex;
     std::string failure;
@@ -182,28 +188,121 @@ struct Pipeline::RunState {
     }
 };
 
+namespace {
+
+// For display only: a matcher that cannot say its range still runs (its failures are
+// the run's to report), the range is then {0, 0}.
+std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
+    try {
+        return m.disparityRange();
+    } catch (const std::exception &e) {
+        spdlog::debug("matcher disparity range: {}", e.what());
+        return {0, 0};
+    }
+}
+
+} // namespace
+
 Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
     source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
     for (int i = 0; i < rig.runtime.matcher_instances; ++i)
         matchers_.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
     for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
-    for (const auto &e : rig.evaluators) {
-        auto slot = std::make_unique<EvaluatorSlot>();
-        slot->name = e.plugin;
-        EvaluatorSlot *raw = slot.get();
-        HostSink sink;
-        sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
-            if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
-            if (!raw->target) return;
-            (*raw->target)[name] = value;
-            if (!unit.empty()) (*raw->target)[name + "_unit"] = unit;
-        };
-        sink.text = [raw](const std::string &name, const std::string &text) {
-            if (raw->target) (*raw->target)[name] = text;
-        };
-        slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
-        evaluators_.push_back(std::move(slot));
+    for (const auto &e : rig.evaluators) evaluators_.push_back(makeEvaluator(e));
+    disparityRange_ = askDisparityRange(*matchers_.front());
+}
+
+std::string Pipeline::sourceStatistics() const {
+    std::lock_guard<std::mutex> lock(statisticsMutex_);
+    return sourceStatistics_;
+}
+
+void Pipeline::refreshSourceStatistics() {
+    std::string stats = source_->statistics();
+    std::lock_guard<std::mutex> lock(statisticsMutex_);
+    sourceStatistics_ = std::move(stats);
+}
+
+std::unique_ptr<Pipeline::EvaluatorSlot> Pipeline::makeEvaluator(const PluginBlock &e) {
+    auto slot = std::make_unique<EvaluatorSlot>();
+    slot->name = e.plugin;
+    EvaluatorSlot *raw = slot.get();
+    HostSink sink;
+    sink.metric = [raw](const std::string &name, double value, const std::string &unit) {
+        if (raw->flat) raw->flat->emplace_back(raw->name + "." + name, value);
+        if (!raw->target) return;
+        (*raw->target)[name] = value;
+        if (!unit.empty()) (*raw->target)[name + "_unit"] = unit;
+    };
+    sink.text = [raw](const std::string &name, const std::string &text) {
+        if (raw->target) (*raw->target)[name] = text;
+    };
+    slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
+    return slot;
+}
+
+namespace {
+
+// Same plugin with the same settings: the instance can stay.
+bool sameBlock(const PluginBlock &a, const PluginBlock &b) {
+    if (a.plugin != b.plugin || a.params.size() != b.params.size()) return false;
+    for (int32_t i = 0; i < a.params.size(); ++i) {
+        const binocle_param &x = a.params.data()[i], &y = b.params.data()[i];
+        if (std::string(x.name) != y.name || x.type != y.type || x.i != y.i || x.explicit_ != y.explicit_) return false;
+        if (!(x.d == y.d || (std::isnan(x.d) && std::isnan(y.d)))) return false;
+        if ((x.s == nullptr) != (y.s == nullptr) || (x.s && std::string(x.s) != y.s)) return false;
     }
+    return true;
+}
+
+} // namespace
+
+void Pipeline::reconfigure(const RigConfig &rig) {
+    // Everything new is created first: a refusal throws before anything is replaced.
+    std::unique_ptr<Source> source;
+    std::vector<std::unique_ptr<Matcher>> matchers;
+    std::vector<std::unique_ptr<CloudTransform>> transforms(rig.transforms.size());
+    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators(rig.evaluators.size());
+    const bool newSource = !sameBlock(rig.source, rig_.source) || rig.calibration_file != rig_.calibration_file;
+    if (newSource) source = std::make_unique<Source>(*rig.source.record, rig.source.params);
+    // As many instances as the stage has threads (runtime.matcher_instances is read when
+    // the pipeline is made).
+    if (!sameBlock(rig.matcher, rig_.matcher))
+        for (size_t i = 0; i < matchers_.size(); ++i)
+            matchers.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
+    const std::pair<int32_t, int32_t> range = matchers.empty() ? disparityRange_ : askDisparityRange(*matchers.front());
+    for (size_t i = 0; i < rig.transforms.size(); ++i)
+        if (i >= rig_.transforms.size() || !sameBlock(rig.transforms[i], rig_.transforms[i]))
+            transforms[i] = std::make_unique<CloudTransform>(*rig.transforms[i].record, rig.transforms[i].params);
+    for (size_t i = 0; i < rig.evaluators.size(); ++i)
+        if (i >= rig_.evaluators.size() || !sameBlock(rig.evaluators[i], rig_.evaluators[i]))
+            evaluators[i] = makeEvaluator(rig.evaluators[i]);
+    if (source && sourceStarted_) {
+        // A camera is held by one instance at a time: the old one lets go first, and
+        // takes the device back when the new one cannot start.
+        source_->stop();
+        try {
+            source->start();
+        } catch (...) {
+            source_->start();
+            throw;
+        }
+    }
+    if (source) {
+        source_ = std::move(source);
+        calibrationReady_ = false; // another source may publish another calibration
+    }
+    if (!matchers.empty()) matchers_ = std::move(matchers);
+    disparityRange_ = range;
+    for (size_t i = 0; i < transforms.size(); ++i)
+        if (!transforms[i]) transforms[i] = std::move(transforms_[i]);
+    transforms_ = std::move(transforms);
+    for (size_t i = 0; i < evaluators.size(); ++i)
+        if (!evaluators[i]) evaluators[i] = std::move(evaluators_[i]);
+    evaluators_ = std::move(evaluators);
+    const int instances = rig_.runtime.matcher_instances;
+    rig_ = rig;
+    rig_.runtime.matcher_instances = instances;
 }
 
 Pipeline::~Pipeline() = default;
@@ -252,8 +351,20 @@ void Pipeline::acquire(RunState &s) {
     };
     try {
         source_->start();
+        sourceStarted_ = true;
+        refreshSourceStatistics();
+        auto lastStatistics = Clock::now();
         while (!s.stopRequested() && !s.aborted) {
             if (s.options.max_frames >= 0 && s.grabbed >= s.options.max_frames) break;
+            if (s.options.between_frames) {
+                // Drain: every grabbed frame through the writer, so that no stage runs a
+                // plugin or holds a frame while the hook may reconfigure the pipeline.
+                std::unique_lock<std::mutex> lock(s.doneMutex);
+                while (s.finished + s.droppedByPolicy < s.grabbed && !s.aborted && !s.stopRequested())
+                    s.doneCv.wait_for(lock, std::chrono::milliseconds(100));
+                lock.unlock();
+                if (s.aborted || s.stopRequested() || !s.options.between_frames()) break;
+            }
             std::unique_ptr<LentFrame> frame;
             try {
                 const auto t0 = Clock::now();
@@ -292,6 +403,10 @@ void Pipeline::acquire(RunState &s) {
                 break;
             }
             if (!calibrationReady_) prepareCalibration(frame->left().size());
+            if (Clock::now() - lastStatistics > std::chrono::milliseconds(500)) {
+                refreshSourceStatistics();
+                lastStatistics = Clock::now();
+            }
             ++s.grabbed;
             RunState::Grabbed g{std::move(frame), Clock::now()};
             if (s.policy == RuntimeOptions::Policy::Latest) {
@@ -307,7 +422,7 @@ void Pipeline::acquire(RunState &s) {
 }
 
 // Stage 2 (one thread per matcher instance): rectify into pooled images, then match.
-void Pipeline::rectifyAndMatch(RunState &s, Matcher &matcher) {
+void Pipeline::rectifyAndMatch(RunState &s, size_t instance) {
     for (;;) {
         std::unique_ptr<Job> job = s.takeJob();
         uint64_t ordinal = 0;
@@ -324,8 +439,11 @@ void Pipeline::rectifyAndMatch(RunState &s, Matcher &matcher) {
         r.sequence = job->frame->raw().sequence;
         r.frame = job->frame.get();
         r.seconds = 0;
+        r.stage_seconds.clear();
         if (!job->failed) {
             try {
+                // Read per frame: reconfigure() may have replaced it between frames.
+                Matcher &matcher = *matchers_[instance];
                 const auto t0 = Clock::now();
                 const cv::Mat left = job->frame->left(), right = job->frame->right();
                 if (calibration_.rectified) {
@@ -335,7 +453,10 @@ void Pipeline::rectifyAndMatch(RunState &s, Matcher &matcher) {
                     cv::remap(left, r.rectified_left, map1x_, map1y_, cv::INTER_LINEAR);
                     cv::remap(right, r.rectified_right, map2x_, map2y_, cv::INTER_LINEAR);
                 }
+                r.stage_seconds.emplace_back("rectify", secondsSince(t0));
+                const auto t1 = Clock::now();
                 matcher.compute(r.rectified_left, r.rectified_right, r.disparity);
+                r.stage_seconds.emplace_back("match", secondsSince(t1));
                 r.seconds += secondsSince(t0);
             } catch (const std::exception &e) {
                 s.fail(e.what());
@@ -356,11 +477,14 @@ void Pipeline::cloudAndTransforms(RunState &s) {
                 const auto t0 = Clock::now();
                 const size_t valid = projector_.project(r.disparity, r.rectified_left, r.cloud);
                 r.valid_pixel_ratio = static_cast<double>(valid) / static_cast<double>(r.disparity.total());
+                r.stage_seconds.emplace_back("cloud", secondsSince(t0));
+                const auto t1 = Clock::now();
                 for (auto &t : transforms_) {
                     binocle_cloud view = r.cloud.view();
                     t->apply(view);
                     r.cloud.adopt(view);
                 }
+                r.stage_seconds.emplace_back("transforms", secondsSince(t1));
                 r.seconds += secondsSince(t0);
             } catch (const std::exception &e) {
                 s.fail(e.what());
@@ -381,6 +505,7 @@ void Pipeline::evaluate(RunState &s) {
         FrameResult &r = (*job)->r;
         r.metrics = Json::object();
         r.figures.clear();
+        if (!(*job)->failed && !s.aborted && evaluators_.empty()) r.stage_seconds.emplace_back("evaluators", 0.0);
         if (!(*job)->failed && !s.aborted && !evaluators_.empty()) {
             try {
                 const auto t0 = Clock::now();
@@ -421,6 +546,7 @@ void Pipeline::evaluate(RunState &s) {
                     slot->flat = nullptr;
                     r.metrics[slot->name] = std::move(figures);
                 }
+                r.stage_seconds.emplace_back("evaluators", secondsSince(t0));
                 r.seconds += secondsSince(t0);
             } catch (const std::exception &e) {
                 s.fail(e.what());
@@ -433,11 +559,10 @@ void Pipeline::evaluate(RunState &s) {
     s.evaluated.producerDone();
 }
 
-void Pipeline::writeOutputs(const FrameResult &r, const std::string &dir) const {
+void writeFrameOutputs(const FrameResult &r, const OutputOptions &o, const std::string &dir) {
     char stem[32];
     std::snprintf(stem, sizeof stem, "%06llu", static_cast<unsigned long long>(r.sequence));
     const fs::path d(dir);
-    const auto &o = rig_.outputs;
     if (o.disparity_png) writeDisparityPng16((d / ("disparity_" + std::string(stem) + ".png")).string(), r.disparity);
     if (o.disparity_color) writeImage((d / ("disparity_color_" + std::string(stem) + ".png")).string(), colorizeDisparity(r.disparity));
     if (o.disparity_pfm) writePfm((d / ("disparity_" + std::string(stem) + ".pfm")).string(), r.disparity);
@@ -496,7 +621,7 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     if (!s.aborted) {
         std::vector<std::thread> threads;
         threads.emplace_back([&] { acquire(s); });
-        for (auto &m : matchers_) threads.emplace_back([&, mp = m.get()] { rectifyAndMatch(s, *mp); });
+        for (size_t i = 0; i < matchers_.size(); ++i) threads.emplace_back([&, i] { rectifyAndMatch(s, i); });
         threads.emplace_back([&] { cloudAndTransforms(s); });
         threads.emplace_back([&] { evaluate(s); });
 
@@ -507,7 +632,7 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
             if (!(*job)->failed && !s.aborted) {
                 try {
                     const auto t0 = Clock::now();
-                    if (!outDir_.empty()) writeOutputs(r, outDir_);
+                    if (!outDir_.empty()) writeFrameOutputs(r, rig_.outputs, outDir_);
                     r.seconds += secondsSince(t0);
                     r.latency_s = secondsSince((*job)->grabbed);
                     Json line = Json::object();
@@ -535,6 +660,11 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
             r.frame = nullptr;
             (*job)->frame.reset();
             s.giveJob(std::move(*job));
+            {
+                std::lock_guard<std::mutex> lock(s.doneMutex);
+                ++s.finished;
+            }
+            s.doneCv.notify_all();
         }
         for (auto &t : threads) t.join();
     }

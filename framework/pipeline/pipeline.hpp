@@ -28,6 +28,12 @@ struct RunOptions {
     // Polled by the run: once true, acquisition stops, the frames in flight are finished
     // and the summary says `interrupted` (StopSignalGuard::requested() for signals).
     const std::atomic<bool> *stop = nullptr;
+    // Called on the acquire stage before each grab, once every frame grabbed so far has
+    // been through the writer (onFrame, observers): no stage holds a frame or runs a
+    // plugin then, so this is the one place where reconfigure() may run. Setting it
+    // serialises the stages (one frame in flight). Returning false ends the run as if
+    // the source ended.
+    std::function<bool()> between_frames;
 };
 
 // What one frame produced, for callers that want more than files (experiments, tests,
@@ -45,6 +51,8 @@ struct FrameResult {
     std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
     double seconds = 0;   // processing time of the frame, all stages added
     double latency_s = 0; // from the grab to the writer stage
+    // Time of each step, in order: rectify, match, cloud, transforms, evaluators.
+    std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
 // A watcher of a run that must never slow it (a live viewer). `onFrame` is called on the
@@ -80,6 +88,10 @@ private:
     std::atomic<uint64_t> skipped_{0};
 };
 
+// Writes what `outputs` asks for of one frame into `dir` (disparity PNG/PFM, colourised
+// disparity, rectified images, cloud PLY), each file atomically; names carry the sequence.
+void writeFrameOutputs(const FrameResult &r, const OutputOptions &outputs, const std::string &dir);
+
 class Pipeline {
 public:
     Pipeline(const RigConfig &rig, const PluginHost &host);
@@ -95,18 +107,33 @@ public:
     // Watches the next runs; the observer must outlive them.
     void addObserver(FrameObserver *observer) { observers_.push_back(observer); }
 
+    // Takes a changed rig between frames (from RunOptions::between_frames): the matcher,
+    // transforms, evaluators and source whose block changed are created anew, all before
+    // any is swapped in, so a plugin that refuses its settings leaves the pipeline as it
+    // was (the PluginError propagates). A new source is started when the old one was.
+    void reconfigure(const RigConfig &rig);
+    // The matcher's own answer (plugin API), not the rig's value; asked when the matcher
+    // is made, so any thread may read it between reconfigure() calls.
+    std::pair<int32_t, int32_t> matcherDisparityRange() const { return disparityRange_; }
+    // The source's statistics as of its last grab (at most ~0.5 s old): any thread, the
+    // source itself is called only from the acquire stage.
+    std::string sourceStatistics() const;
+    const RigConfig &rig() const { return rig_; }
+
     const StereoCalibration &calibration() const { return calibration_; }
     Source &source() { return *source_; }
 
 private:
     struct Job;
     struct RunState;
+    struct EvaluatorSlot;
     void prepareCalibration(const cv::Size &imageSize);
     void acquire(RunState &s);
-    void rectifyAndMatch(RunState &s, Matcher &matcher);
+    void rectifyAndMatch(RunState &s, size_t instance);
     void cloudAndTransforms(RunState &s);
     void evaluate(RunState &s);
-    void writeOutputs(const FrameResult &r, const std::string &dir) const;
+    void refreshSourceStatistics();
+    std::unique_ptr<EvaluatorSlot> makeEvaluator(const PluginBlock &block);
 
     RigConfig rig_;
     std::unique_ptr<Source> source_;
@@ -120,6 +147,10 @@ private:
     };
     std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
     std::vector<FrameObserver *> observers_;
+    bool sourceStarted_ = false;
+    std::pair<int32_t, int32_t> disparityRange_{0, 0}; // asked of the matcher when it is made
+    mutable std::mutex statisticsMutex_;
+    std::string sourceStatistics_; // the source's statistics, refreshed by the acquire stage
     StereoCalibration calibration_;
     std::string calibrationYaml_;
     bool calibrationReady_ = false;

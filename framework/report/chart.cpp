@@ -40,19 +40,6 @@ public:
                       bool vertical = false) = 0;
 };
 
-std::string escapeXml(const std::string &s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '&': out += "&amp;"; break;
-        case '"': out += "&quot;"; break;
-        default: out += c;
-        }
-    }
-    return out;
-}
 
 class SvgCanvas : public Canvas {
 public:
@@ -322,6 +309,20 @@ void writeChart(const std::string &stem, const BarChart &chart) {
 void writeChart(const std::string &stem, const ScatterChart &chart) {
     writeImage(stem + ".png", toImage(chart));
     writeFileAtomic(stem + ".svg", toSvg(chart));
+}
+
+std::string escapeXml(const std::string &s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '&': out += "&amp;"; break;
+        case '"': out += "&quot;"; break;
+        default: out += c;
+        }
+    }
+    return out;
 }
 
 } // namespace binocle

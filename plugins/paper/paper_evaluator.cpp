@@ -14,6 +14,7 @@
 
 #include <binocle/plugin.hpp>
 
+#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -170,6 +171,7 @@ public:
         if (e2_) range = evaluateE2(cloud, truth, drawings);
         else range = evaluatePanel(cloud, truth, drawings, panel);
         reportDesign(truth, range, panel ? &*panel : nullptr);
+        host_.text("view_overlays", overlaysJson(drawings));
         if (p_.boolean("write_views")) writeViews(cloud, in.output_dir, drawings);
     }
 
@@ -376,6 +378,25 @@ private:
             metric("panel_fits", f.panel_fits_width && f.panel_fits_height ? 1 : 0);
             metric("panel_width_ratio", f.panel_width_ratio);
         }
+    }
+
+    // The boxes drawn on the density views, for hosts that draw the views themselves
+    // (the live viewer): {"top": [{"u_mm": [a, b], "v_mm": [a, b], "label": .., "bgr": [..]}], ...}.
+    static std::string overlaysJson(const Drawings &d) {
+        nlohmann::ordered_json j = nlohmann::ordered_json::object();
+        auto list = [](const std::vector<method::ViewOverlay> &v) {
+            nlohmann::ordered_json a = nlohmann::ordered_json::array();
+            for (const method::ViewOverlay &o : v)
+                a.push_back({{"u_mm", {o.u.min_mm, o.u.max_mm}},
+                             {"v_mm", {o.v.min_mm, o.v.max_mm}},
+                             {"label", o.label},
+                             {"bgr", {o.color[0], o.color[1], o.color[2]}}});
+            return a;
+        };
+        j["top"] = list(d.top);
+        j["front"] = list(d.front);
+        j["side"] = list(d.side);
+        return j.dump();
     }
 
     void writeViews(const method::CloudView &cloud, const char *outputDir, const Drawings &drawings) {

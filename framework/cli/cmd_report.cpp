@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// `binocle report DIR`: a self-contained HTML report of an experiment's results.
+#include "cli/command.hpp"
+#include "report/html_report.hpp"
+
+#include <iostream>
+
+namespace binocle::cli {
+namespace {
+
+struct ReportArgs {
+    std::string dir, output;
+};
+
+int report(const ReportArgs &args) {
+    const std::vector<std::string> dirs = report::experimentFolders(args.dir);
+    if (!args.output.empty() && dirs.size() > 1)
+        throw UsageError("--output " + args.output + ": " + args.dir + " holds " + std::to_string(dirs.size()) +
+                         " experiments; without --output each gets DIR/<experiment>/report.html");
+    for (const auto &dir : dirs) std::cout << report::writeExperimentReport(dir, args.output) << "\n";
+    return 0;
+}
+
+Register reg{{"report", "an experiment's results as one self-contained HTML file (table, charts, images)",
+              "Reads what `binocle experiment --out DIR` wrote (results.json, charts, test_<id>/)\n"
+              "and writes DIR/report.html: the results table (sortable), the charts, η3D against\n"
+              "the form factor, every test's disparity and top/front/side density views, the\n"
+              "paper's values beside the measured ones where the experiment file names them\n"
+              "(`paper:` per test), the rig and the software versions. Images are inlined: the\n"
+              "file opens from disk with no server and no network. When DIR holds several\n"
+              "experiment folders (e.g. out/demo), each gets its own report.",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<ReportArgs>();
+                  app.add_option("dir", args->dir, "the experiment's output folder")->type_name("DIR")->required();
+                  app.add_option("--output", args->output, "where to write (one experiment only; default DIR/report.html)")
+                      ->type_name("FILE");
+                  return [args] { return report(*args); };
+              }}};
+
+} // namespace
+} // namespace binocle::cli

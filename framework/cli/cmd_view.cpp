@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// `binocle view RIG.yaml`: the rig's pipeline with a live web page on this machine.
+#include "cli/command.hpp"
+#include "viewer/viewer.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+
+namespace binocle::cli {
+namespace {
+
+struct ViewArgs {
+    RigArgs rig;
+    viewer::ViewOptions options;
+    int64_t frames = -1;
+};
+
+int view(ViewArgs &args) {
+    viewer::ViewOptions o = args.options;
+    o.rig_file = args.rig.file;
+    for (const auto &s : args.rig.overrides) o.overrides.push_back(Override::parse(s));
+    o.max_frames = args.frames;
+    PluginHost host;
+    host.scan();
+    const viewer::ViewSummary s = viewer::runView(o, host, [](const std::string &url) {
+        std::cout << "binocle view: open " << url << "\n" << std::flush;
+    });
+    const nlohmann::ordered_json j = {{"frames", s.frames},
+                                      {"frames_sent", s.frames_sent},
+                                      {"seconds", s.seconds},
+                                      {"pipeline_fps", s.pipeline_fps},
+                                      {"processing_fps", s.processing_fps},
+                                      {"status", s.status}};
+    std::cout << j.dump() << "\n";
+    return 0;
+}
+
+Register reg{{"view", "a live web page of a rig: images, disparity, density views, cloud, figures, controls",
+              "Runs the rig's pipeline and serves a page on this machine that shows the rectified\n"
+              "images, the colourised disparity (scale in px and m), the top/front/side density\n"
+              "views with the objects and panel the evaluators found, the cloud in 3D, and every\n"
+              "figure per frame. Its controls come from the plugins' settings tables; a change is\n"
+              "validated like --set and applied between frames. Pause, step and snapshot (the\n"
+              "frame's outputs, as `binocle run` writes them, into --out).\n"
+              "The URL printed at start carries a token that the page's controls need. Only\n"
+              "requests naming this machine (localhost, 127.0.0.1, ::1) are served. Browsers that\n"
+              "are slow get fewer frames; the pipeline never waits for them. Ctrl-C stops.\n"
+              "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
+              [](CLI::App &app) -> Runner {
+                  auto args = std::make_shared<ViewArgs>();
+                  addRigArgs(app, args->rig);
+                  app.add_option("--port", args->options.port, "TCP port (0: any free port)")
+                      ->type_name("N")
+                      ->check(CLI::Range(0, 65535))
+                      ->capture_default_str();
+                  app.add_option("--bind", args->options.address, "address to listen on")->type_name("ADDR")->capture_default_str();
+                  app.add_option("--out", args->options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
+                  app.add_option("--display-fps", args->options.display_fps, "most frames per second sent to browsers")
+                      ->type_name("F")
+                      ->check(positiveNumber())
+                      ->capture_default_str();
+                  app.add_option("--frames", args->frames, "stop after N frames (measurements)")->type_name("N")->check(atLeast(1));
+                  app.add_flag("--paused", args->options.paused, "start paused on the first frame");
+                  return [args] { return view(*args); };
+              }}};
+
+} // namespace
+} // namespace binocle::cli
