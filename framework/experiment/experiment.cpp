@@ -721,9 +721,20 @@ OJson predictorRho(const std::vector<Row> &rows) {
 }
 
 // What produced the results, for the report: binocle's and each plugin's version.
-OJson software(const PluginHost &host) {
+// Only the plugins the rig names: the same list whichever others the host has opened.
+OJson software(const PluginHost &host, const YAML::Node &rig) {
+    std::set<std::string> named;
+    auto add = [&](const YAML::Node &block) {
+        if (block.IsMap() && block["plugin"] && block["plugin"].IsScalar()) named.insert(block["plugin"].Scalar());
+    };
+    for (const char *key : {"source", "matcher"}) add(rig[key]);
+    for (const char *key : {"transforms", "evaluators"})
+        if (rig[key] && rig[key].IsSequence())
+            for (const auto &b : rig[key]) add(b);
     OJson plugins = OJson::array();
-    for (const auto &p : host.plugins()) plugins.push_back({{"name", p.name}, {"version", p.version}, {"kind", kindName(p.kind)}});
+    for (const auto &name : named) // sorted by name
+        for (const auto &p : host.plugins())
+            if (p.name == name) plugins.push_back({{"name", p.name}, {"version", p.version}, {"kind", kindName(p.kind)}});
     return {{"binocle", BINOCLE_VERSION}, {"opencv", CV_VERSION}, {"plugins", std::move(plugins)}};
 }
 
@@ -1049,7 +1060,7 @@ ExperimentResult resultOf(const std::vector<Row> &rows) {
 
 TablesMeta metaOf(const Experiment &e, int shardIndex, int shardCount, const PluginHost &host) {
     TablesMeta m;
-    m.software = software(host);
+    m.software = software(host, e.rig);
     for (const auto &t : e.tests) m.test_ids.push_back(t.id);
     m.shard_index = shardIndex;
     m.shard_count = shardCount;
