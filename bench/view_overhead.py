@@ -3,9 +3,13 @@
 # every frame it can, against the same view with no browser open, in one run
 # (alternating, several rounds, medians). Both rates are read the same way: the
 # pipeline's frame counter (/api/state) over a fixed window after a warm-up.
+# Where the CPU went is measured in the same windows (/proc): the view process (pipeline
+# + encoder + server), the browser (every process under chromedriver), and the whole
+# machine (other users of a shared box included), in cores (1.0 = one core busy).
 #
-# usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10] [--set KEY=VALUE]...
-#   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH as for the CLI.
+# usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10]
+#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--json FILE]
+#   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH (absolute) as for the CLI.
 # Run it inside scripts/netns-test.sh to keep everything on loopback.
 import argparse
 import http.client
@@ -27,8 +31,11 @@ parser.add_argument("--rounds", type=int, default=3)
 parser.add_argument("--seconds", type=float, default=10)
 parser.add_argument("--warmup", type=float, default=3)
 parser.add_argument("--set", action="append", default=[])
+parser.add_argument("--view-arg", action="append", default=[], help="more arguments for `binocle view`")
+parser.add_argument("--json", help="also write the medians and every round here")
 args = parser.parse_args()
 cli = os.environ.get("BINOCLE_CLI", os.path.join(root, "build/bin/binocle"))
+TICK = os.sysconf("SC_CLK_TCK")
 
 
 def frames(port, token):
@@ -39,15 +46,53 @@ def frames(port, token):
     return state["frames_processed"], time.monotonic()
 
 
+def cpu_seconds(pids):
+    """User + system CPU seconds of these processes (every thread), as of now."""
+    total = 0.0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            total += (int(fields[11]) + int(fields[12])) / TICK
+        except (OSError, IndexError, ValueError):
+            pass  # ended meanwhile
+    return total
+
+
+def descendants(pid):
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+                children.setdefault(ppid, []).append(int(entry))
+            except (OSError, IndexError, ValueError):
+                pass
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        todo.extend(children.get(p, []))
+    return out
+
+
+def machine_busy():
+    """(busy, total) jiffies of all CPUs."""
+    with open("/proc/stat") as f:
+        v = [int(x) for x in f.readline().split()[1:]]
+    idle = v[3] + v[4]
+    return sum(v) - idle, sum(v)
+
+
 def measure(with_browser):
-    cmd = [cli, "view", args.rig, "--port", "0", "--out", "/tmp/binocle-view-bench"]
+    cmd = [cli, "view", args.rig, "--port", "0", "--out", "/tmp/binocle-view-bench"] + args.view_arg
     for s in args.set:
         cmd += ["--set", s]
     view = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     m = re.search(r"(http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]+))", view.stdout.readline())
     url, port, token = m.group(1), int(m.group(2)), m.group(3)
     driver = None
-    shown = 0
     try:
         if with_browser:
             driver = start_browser()
@@ -56,31 +101,59 @@ def measure(with_browser):
             while driver.execute_script("return window.binocle.framesReceived") < 1 and time.time() < end:
                 time.sleep(0.1)
         time.sleep(args.warmup)
+        browser = descendants(driver.service.process.pid) if driver else []
         n0, t0 = frames(port, token)
+        v0, b0, m0 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
         s0 = driver.execute_script("return window.binocle.framesReceived") if driver else 0
         time.sleep(args.seconds)
         n1, t1 = frames(port, token)
-        if driver:
-            shown = driver.execute_script("return window.binocle.framesReceived") - s0
+        v1, b1, m1 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
+        shown = driver.execute_script("return window.binocle.framesReceived") - s0 if driver else 0
+        load = os.getloadavg()[0]
     finally:
         if driver:
             driver.quit()
         view.terminate()
         view.wait(timeout=20)
-    return (n1 - n0) / (t1 - t0), shown / (t1 - t0)
+    dt = t1 - t0
+    cores = os.cpu_count()
+    busy = cores * (m1[0] - m0[0]) / max(1, m1[1] - m0[1])
+    return {"pipeline_fps": (n1 - n0) / dt, "page_fps": shown / dt, "view_cores": (v1 - v0) / dt,
+            "browser_cores": (b1 - b0) / dt, "machine_busy_cores": busy,
+            "others_cores": max(0.0, busy - (v1 - v0) / dt - (b1 - b0) / dt), "load_1min": load}
 
 
-without, with_, displayed = [], [], []
+rounds = []
 for r in range(args.rounds):
-    a, _ = measure(False)
-    b, shown = measure(True)
-    without.append(a)
-    with_.append(b)
-    displayed.append(shown)
-    print(f"round {r + 1}: pipeline {a:.1f} fps without a browser, {b:.1f} fps with one (page shows {shown:.1f} fps)",
-          flush=True)
-fa, fb = statistics.median(without), statistics.median(with_)
-print(json.dumps({"rig": os.path.basename(args.rig), "rounds": args.rounds, "window_s": args.seconds,
-                  "fps_without_browser": round(fa, 2), "fps_with_browser": round(fb, 2),
-                  "page_fps": round(statistics.median(displayed), 2),
-                  "ratio": round(fb / fa, 3), "drop_percent": round(100 * (1 - fb / fa), 1)}))
+    # Alternate which goes first, so that a trend in the machine's load hits both alike.
+    order = (False, True) if r % 2 == 0 else (True, False)
+    got = {w: measure(w) for w in order}
+    a, b = got[False], got[True]
+    rounds.append({"without": a, "with": b})
+    print(f"round {r + 1}: pipeline {a['pipeline_fps']:.1f} fps without a browser, {b['pipeline_fps']:.1f} fps with one "
+          f"(page shows {b['page_fps']:.1f} fps; view process {a['view_cores']:.2f} -> {b['view_cores']:.2f} cores, "
+          f"browser {b['browser_cores']:.2f} cores, others on the machine {a['others_cores']:.2f} / "
+          f"{b['others_cores']:.2f} cores, load {a['load_1min']:.1f} / {b['load_1min']:.1f})", flush=True)
+
+
+def med(which, key):
+    return statistics.median(x[which][key] for x in rounds)
+
+
+ratios = [x["with"]["pipeline_fps"] / x["without"]["pipeline_fps"] for x in rounds if x["without"]["pipeline_fps"] > 0]
+result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "rounds": args.rounds, "window_s": args.seconds,
+          "cores": os.cpu_count(),
+          "fps_without_browser": round(med("without", "pipeline_fps"), 2),
+          "fps_with_browser": round(med("with", "pipeline_fps"), 2),
+          "page_fps": round(med("with", "page_fps"), 2),
+          "median_ratio": round(statistics.median(ratios), 3) if ratios else None,
+          "drop_percent": round(100 * (1 - statistics.median(ratios)), 1) if ratios else None,
+          "view_cores_without": round(med("without", "view_cores"), 2),
+          "view_cores_with": round(med("with", "view_cores"), 2),
+          "browser_cores": round(med("with", "browser_cores"), 2),
+          "others_cores_without": round(med("without", "others_cores"), 2),
+          "others_cores_with": round(med("with", "others_cores"), 2)}
+print(json.dumps(result))
+if args.json:
+    with open(args.json, "w") as f:
+        json.dump({"medians": result, "rounds": rounds}, f, indent=1)

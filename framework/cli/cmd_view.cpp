@@ -28,6 +28,7 @@ int view(ViewArgs &args) {
     });
     const nlohmann::ordered_json j = {{"frames", s.frames},
                                       {"frames_sent", s.frames_sent},
+                                      {"encode_ms_per_frame", s.frames_sent > 0 ? 1000 * s.encode_seconds / s.frames_sent : 0.0},
                                       {"seconds", s.seconds},
                                       {"pipeline_fps", s.pipeline_fps},
                                       {"processing_fps", s.processing_fps},
@@ -56,9 +57,14 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                       ->capture_default_str();
                   app.add_option("--bind", args->options.address, "address to listen on")->type_name("ADDR")->capture_default_str();
                   app.add_option("--out", args->options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
-                  app.add_option("--display-fps", args->options.display_fps, "most frames per second sent to browsers")
+                  app.add_option("--display-fps", args->options.display_fps,
+                                 "most frames per second sent to browsers (each gets no more than it can draw)")
                       ->type_name("F")
                       ->check(positiveNumber())
+                      ->capture_default_str();
+                  app.add_option("--cloud-points", args->options.cloud_points, "most points drawn in the 3D view (thinned evenly)")
+                      ->type_name("N")
+                      ->check(atLeast(1))
                       ->capture_default_str();
                   app.add_option("--frames", args->frames, "stop after N frames (measurements)")->type_name("N")->check(atLeast(1));
                   app.add_flag("--paused", args->options.paused, "start paused on the first frame");

@@ -356,7 +356,7 @@ void Pipeline::acquire(RunState &s) {
         auto lastStatistics = Clock::now();
         while (!s.stopRequested() && !s.aborted) {
             if (s.options.max_frames >= 0 && s.grabbed >= s.options.max_frames) break;
-            if (s.options.between_frames) {
+            if (s.options.between_frames && (!s.options.between_frames_wanted || s.options.between_frames_wanted->load())) {
                 // Drain: every grabbed frame through the writer, so that no stage runs a
                 // plugin or holds a frame while the hook may reconfigure the pipeline.
                 std::unique_lock<std::mutex> lock(s.doneMutex);

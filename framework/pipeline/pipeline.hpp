@@ -28,12 +28,15 @@ struct RunOptions {
     // Polled by the run: once true, acquisition stops, the frames in flight are finished
     // and the summary says `interrupted` (StopSignalGuard::requested() for signals).
     const std::atomic<bool> *stop = nullptr;
-    // Called on the acquire stage before each grab, once every frame grabbed so far has
+    // Called on the acquire stage before a grab, once every frame grabbed so far has
     // been through the writer (onFrame, observers): no stage holds a frame or runs a
-    // plugin then, so this is the one place where reconfigure() may run. Setting it
-    // serialises the stages (one frame in flight). Returning false ends the run as if
-    // the source ended.
+    // plugin then, so this is the one place where reconfigure() may run. Returning false
+    // ends the run as if the source ended.
     std::function<bool()> between_frames;
+    // Null: between_frames runs before every grab, which serialises the stages (one
+    // frame in flight). Set: only while it is true (a change or a pause is pending), so
+    // the stages run in parallel the rest of the time and drain only when needed.
+    const std::atomic<bool> *between_frames_wanted = nullptr;
 };
 
 // What one frame produced, for callers that want more than files (experiments, tests,

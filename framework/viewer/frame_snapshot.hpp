@@ -40,12 +40,12 @@ nlohmann::ordered_json colorScale();
 struct EncodeOptions {
     int jpeg_quality = 85;
     int view_px = 320;           // longer side of each density view
-    size_t max_cloud_points = 30000;
+    size_t max_cloud_points = 20000; // the cloud is thinned evenly to at most this
     method::GridSpec grid;
 };
 
 // One binary message: a 4-byte little-endian header length, the header (JSON: figures,
-// and `blobs`: [{name, type, offset, size}]), then the blobs (JPEG/PNG images, the
+// and `blobs`: [{name, type, offset, size}]), then the blobs (JPEG images, the
 // cloud as float32 x, y, z in metres followed by uint8 r, g, b).
 std::string encodeFrame(const FrameProducts &p, const EncodeOptions &options);
 

@@ -32,6 +32,9 @@ namespace {
 
 // Texts a browser has not read yet beyond this: it is gone or stuck; it is dropped.
 constexpr size_t kMaxQueuedTexts = 256;
+// A page says when it has shown a frame (kShownMessage); one that does not (an old page,
+// a hidden tab) gets the next frame after this long.
+constexpr auto kShownTimeout = std::chrono::seconds(2);
 
 std::string percentDecode(const std::string &s) {
     std::string out;
@@ -135,7 +138,10 @@ public:
         ready_ = false;
         net::post(ws_.get_executor(), [self = shared_from_this(), frame] { self->pushFrame(frame); });
     }
-    bool ready() const { return ready_; }
+    // Nothing to write, and the page has shown the last frame (or took too long to say).
+    bool ready() const {
+        return ready_ && (!showing_ || std::chrono::steady_clock::now().time_since_epoch().count() > shownDeadline_.load());
+    }
 
 private:
     void pushText(std::shared_ptr<const std::string> text) {
@@ -159,6 +165,8 @@ private:
             current_ = std::move(frame_);
             frame_.reset();
             binary = true;
+            shownDeadline_ = (std::chrono::steady_clock::now() + kShownTimeout).time_since_epoch().count();
+            showing_ = true;
         } else {
             ready_ = true;
             return;
@@ -175,9 +183,14 @@ private:
     void read() {
         ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, size_t) {
             if (ec) return self->drop();
-            if (self->ws_.got_text() && self->server_->handlers.command) {
-                const std::string reply = self->server_->handlers.command(beast::buffers_to_string(self->buffer_.data()));
-                if (!reply.empty()) self->pushText(std::make_shared<const std::string>(reply));
+            if (self->ws_.got_text()) {
+                const std::string text = beast::buffers_to_string(self->buffer_.data());
+                if (text == kShownMessage) {
+                    self->showing_ = false; // flow control: this browser is ready for the next frame
+                } else if (self->server_->handlers.command) {
+                    const std::string reply = self->server_->handlers.command(text);
+                    if (!reply.empty()) self->pushText(std::make_shared<const std::string>(reply));
+                }
             }
             self->buffer_.consume(self->buffer_.size());
             self->read();
@@ -201,6 +214,10 @@ private:
     std::shared_ptr<const std::string> frame_, current_;
     bool writing_ = false, closed_ = false;
     std::atomic<bool> ready_{false};
+    // A frame was written and the page has not said it has shown it (before the deadline,
+    // steady_clock ticks).
+    std::atomic<bool> showing_{false};
+    std::atomic<int64_t> shownDeadline_{0};
 };
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {

@@ -10,6 +10,10 @@
 
 namespace binocle::viewer {
 
+// What a page sends once it has shown a frame: the server's flow control, so that a
+// browser gets frames no faster than it can draw them.
+inline constexpr const char *kShownMessage = R"({"op":"shown"})";
+
 struct HttpReply {
     int status = 200;
     std::string content_type = "application/json";
@@ -40,8 +44,8 @@ public:
     const std::string &token() const;
     std::string url() const; // http://ADDRESS:PORT/?token=...
 
-    // True when some browser has no frame waiting or being written: only then is a frame
-    // worth encoding.
+    // True when some browser has no frame waiting or being written and has shown the last
+    // one (its page sends kShownMessage once it has): only then is a frame worth encoding.
     bool wantsFrame() const;
     size_t browsers() const;
     // Every browser gets the newest frame; one still sending an older frame gets this

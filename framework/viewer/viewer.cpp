@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
-// The live view: a pipeline thread, an encoder thread and the server thread. The
-// pipeline hands a frame over only when a browser is ready for one and the encoder is
-// idle (a try-lock, never a wait); settings are validated like --set and applied by the
-// pipeline itself between frames.
+// The live view: the pipeline (its stages in parallel), an encoder thread and the server
+// thread. An observer on the writer stage copies a frame only when a browser is ready for
+// one, the encoder is idle and the display rate allows; settings are validated like
+// --set and applied between frames, the stages draining only while a change is pending.
 #include "viewer/viewer.hpp"
 
 #include "core/error.hpp"
@@ -41,9 +41,11 @@ public:
         rig_ = loadRig(options.rig_file, options.overrides, host);
         paused_ = options.paused;
         step_ = options.paused; // paused from the start: one frame to look at
+        updateWanted();
         if (options.display_fps > 0)
             minInterval_ = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options.display_fps));
         encode_.grid = method::GridSpec{};
+        encode_.max_cloud_points = options.cloud_points;
     }
 
     ViewSummary run(const std::function<void(const std::string &)> &listening) {
@@ -78,6 +80,7 @@ public:
         {
             std::lock_guard<std::mutex> lock(mutex_);
             quit_ = true;
+            updateWanted();
         }
         cv_.notify_all();
         pipeline.join();
@@ -92,8 +95,10 @@ public:
 
         ViewSummary s;
         std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard<std::mutex> stats(statsMutex_);
         s.frames = processed_;
         s.frames_sent = sent_;
+        s.encode_seconds = encodeSeconds_;
         s.seconds = std::chrono::duration<double>(lastFrameEnd_ - firstFrameStart_).count();
         s.pipeline_fps = s.seconds > 0 ? processed_ / s.seconds : 0;
         s.processing_fps = busySeconds_ > 0 ? processed_ / busySeconds_ : 0;
@@ -114,16 +119,22 @@ private:
                 restart_ = false;
                 status_ = "running";
                 error_.clear();
+                updateWanted();
             }
             broadcastState();
             std::string failure;
             try {
                 Pipeline pipeline(rig, host_);
+                Watcher watcher(*this, pipeline);
+                pipeline.addObserver(&watcher);
                 RunOptions run;
                 run.progress = false;
-                run.max_frames = options_.max_frames > 0 ? options_.max_frames - processed_ : -1;
+                run.max_frames = options_.max_frames > 0 ? options_.max_frames - processed_.load() : -1;
+                // The stages run in parallel; they drain to one frame in flight only while
+                // a change, a pause or a stop waits (wanted_).
                 run.between_frames = [&] { return betweenFrames(pipeline); };
-                pipeline.run(run, [&](const FrameResult &r) { onFrame(pipeline, r); });
+                run.between_frames_wanted = &wanted_;
+                pipeline.run(run);
             } catch (const std::exception &e) {
                 failure = e.what();
                 spdlog::error("view: the pipeline stopped: {}", failure);
@@ -148,6 +159,13 @@ private:
         finished_ = true;
     }
 
+    // Whether the acquire stage must stop at the next frame boundary (under mutex_).
+    void updateWanted() {
+        wanted_ = quit_ || restart_ || paused_ || step_ || pendingRig_.has_value();
+        pausedNow_ = paused_;
+    }
+
+    // On the acquire stage, with no frame in flight (RunOptions::between_frames).
     bool betweenFrames(Pipeline &pipeline) {
         std::unique_lock<std::mutex> lock(mutex_);
         for (;;) {
@@ -177,61 +195,63 @@ private:
                 if (!failure.empty()) server_->broadcastText(dumpJson({{"type", "error"}, {"message", failure}}));
                 lock.lock();
                 if (paused_) step_ = true; // show what the change does
+                updateWanted();
                 continue;
             }
             if (!paused_ || step_) {
                 step_ = false;
+                updateWanted();
                 return true;
             }
             cv_.wait(lock);
         }
     }
 
+    // The pipeline's observer, on its writer stage: counts every frame, and copies one
+    // for the encoder only when a browser has taken the last one, the encoder is idle
+    // and the display rate allows; every other frame costs a few comparisons.
+    class Watcher : public FrameObserver {
+    public:
+        Watcher(View &view, Pipeline &pipeline) : view_(view), pipeline_(pipeline) {}
+        void onFrame(const FrameResult &r) override { view_.onFrame(pipeline_, r); }
+
+    private:
+        View &view_;
+        Pipeline &pipeline_;
+    };
+
     void onFrame(Pipeline &pipeline, const FrameResult &r) {
         const auto now = Clock::now();
+        double fps = 0;
         {
-            std::lock_guard<std::mutex> lock(mutex_);
+            std::lock_guard<std::mutex> lock(statsMutex_);
             if (processed_ == 0) firstFrameStart_ = now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(r.seconds));
             lastFrameEnd_ = now;
-            ++processed_;
             busySeconds_ += r.seconds;
             recent_.push_back(now);
             while (recent_.size() > 2 && now - recent_.front() > std::chrono::seconds(2)) recent_.pop_front();
-        }
-        bool stepped = false;
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            stepped = paused_;
-        }
-        std::unique_lock<std::mutex> slot(slotMutex_, std::defer_lock);
-        if (stepped) {
-            // A frame made by `step`: the user waits for exactly this one, and the
-            // pipeline is paused anyway, so it waits for the encoder rather than skip.
-            if (server_->browsers() == 0) return;
-            slot.lock();
-            slotCv_.wait(slot, [&] { return (!slot_ && !encoderBusy_) || encoderQuit_; });
-        } else {
-            // The display takes a frame only when someone can look at it; otherwise this
-            // callback costs a few comparisons.
-            if (!server_->wantsFrame() || encoderBusy_ || now - lastHandOver_ < minInterval_) return;
-            slot.try_lock();
-            if (!slot.owns_lock() || slot_) return;
-        }
-        auto p = std::make_shared<FrameProducts>(copyFrame(r));
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            p->frames_processed = static_cast<uint64_t>(processed_);
             const double span = std::chrono::duration<double>(recent_.back() - recent_.front()).count();
-            p->pipeline_fps = recent_.size() > 1 && span > 0 ? (recent_.size() - 1) / span : 0;
+            fps = recent_.size() > 1 && span > 0 ? (recent_.size() - 1) / span : 0;
         }
+        const int64_t processed = ++processed_;
+        if (server_->browsers() == 0) return;
+        // While paused, the frames still in flight and a stepped one are what the user
+        // waits for: each replaces the one waiting, whatever the browsers are doing.
+        const bool paused = pausedNow_;
+        if (!paused && (encoderBusy_ || now - lastHandOver_.load() < minInterval_ || !server_->wantsFrame())) return;
+        auto p = std::make_shared<FrameProducts>(copyFrame(r));
+        p->frames_processed = static_cast<uint64_t>(processed);
+        p->pipeline_fps = fps;
         p->disparity_range = pipeline.matcherDisparityRange();
         p->focal_length_px = pipeline.calibration().focalLengthPx();
         p->baseline_mm = pipeline.calibration().baselineMm();
         p->source_statistics = pipeline.sourceStatistics(); // the source belongs to the acquire stage
-        slot_ = std::move(p);
-        encoderBusy_ = true;
-        lastHandOver_ = now;
-        slot.unlock();
+        {
+            std::lock_guard<std::mutex> slot(slotMutex_);
+            slot_ = std::move(p);
+            encoderBusy_ = true;
+            lastHandOver_ = now;
+        }
         slotCv_.notify_all();
     }
 
@@ -240,17 +260,18 @@ private:
         std::unique_lock<std::mutex> lock(slotMutex_);
         for (;;) {
             slotCv_.wait(lock, [&] { return slot_ || encoderQuit_; });
-            // (the pipeline's hand-over waits on the same condition variable)
             if (encoderQuit_) return;
             std::shared_ptr<const FrameProducts> p = std::move(slot_);
             slot_.reset();
             lock.unlock();
             std::shared_ptr<const std::string> message;
+            const auto t0 = Clock::now();
             try {
                 message = std::make_shared<const std::string>(encodeFrame(*p, encode_));
             } catch (const std::exception &e) {
                 spdlog::error("view: frame {} could not be encoded: {}", p->result.sequence, e.what());
             }
+            encodeSeconds_ += std::chrono::duration<double>(Clock::now() - t0).count(); // this thread only
             if (message) {
                 {
                     std::lock_guard<std::mutex> last(lastMutex_);
@@ -258,12 +279,10 @@ private:
                     lastMessage_ = message;
                 }
                 server_->broadcastFrame(message);
-                std::lock_guard<std::mutex> counters(mutex_);
                 ++sent_;
             }
             lock.lock();
-            encoderBusy_ = false;
-            slotCv_.notify_all(); // a stepped frame may be waiting for the encoder
+            encoderBusy_ = slot_ != nullptr; // a paused frame may have come meanwhile
         }
     }
 
@@ -277,7 +296,7 @@ private:
         s["paused"] = paused_;
         s["running"] = running_;
         s["last_change"] = lastChange_;
-        s["frames_processed"] = processed_;
+        s["frames_processed"] = processed_.load();
         const std::vector<Override> &shown = pendingRig_ ? pendingOverrides_ : overrides_;
         OJson list = OJson::array();
         for (const Override &o : shown) list.push_back({{"key", o.path}, {"value", o.value}});
@@ -311,13 +330,16 @@ private:
         } else if (op == "pause" || op == "resume") {
             std::lock_guard<std::mutex> lock(mutex_);
             paused_ = op == "pause";
+            updateWanted();
         } else if (op == "step") {
             std::lock_guard<std::mutex> lock(mutex_);
             paused_ = true;
             step_ = true;
+            updateWanted();
         } else if (op == "restart") {
             std::lock_guard<std::mutex> lock(mutex_);
             restart_ = true;
+            updateWanted();
         } else if (op == "reset") {
             return dumpJson(applyOverrides(options_.overrides, "reset"));
         } else if (op == "snapshot") {
@@ -372,6 +394,7 @@ private:
                 overrides_ = overrides;
                 restart_ = true;
             }
+            updateWanted();
         }
         cv_.notify_all();
         broadcastState();
@@ -432,19 +455,26 @@ private:
     std::vector<Override> pendingOverrides_;
     bool paused_ = false, step_ = false, quit_ = false, restart_ = false, running_ = false;
     std::string status_ = "starting", error_, lastChange_;
-    int64_t processed_ = 0, sent_ = 0;
+    std::atomic<bool> finished_{false};
+    // What the pipeline's stages read without taking mutex_ (updateWanted()).
+    std::atomic<bool> wanted_{false}, pausedNow_{false};
+
+    // Counted by the observer (writer stage); statsMutex_ guards the times.
+    std::atomic<int64_t> processed_{0}, sent_{0};
+    std::mutex statsMutex_;
     double busySeconds_ = 0;
     Clock::time_point firstFrameStart_{}, lastFrameEnd_{};
     std::deque<Clock::time_point> recent_;
-    std::atomic<bool> finished_{false};
 
-    // The hand-over slot (pipeline -> encoder).
+    // The hand-over slot (observer -> encoder); encoderBusy_ and lastHandOver_ are
+    // written under slotMutex_ and read by the observer without it.
     std::mutex slotMutex_;
     std::condition_variable slotCv_;
     std::shared_ptr<FrameProducts> slot_;
     bool encoderQuit_ = false;
+    double encodeSeconds_ = 0; // encoder thread; read after it is joined
     std::atomic<bool> encoderBusy_{false};
-    Clock::time_point lastHandOver_{};
+    std::atomic<Clock::time_point> lastHandOver_{};
 
     // The frame on screen.
     std::mutex lastMutex_;

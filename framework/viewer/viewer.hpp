@@ -19,7 +19,8 @@ struct ViewOptions {
     std::string address = "127.0.0.1";
     int port = 8080;                 // 0: any free port
     std::string out_dir = "out/view"; // where snapshots go
-    double display_fps = 15;         // most frames per second sent to the browsers
+    double display_fps = 10;         // most frames per second sent to the browsers
+    size_t cloud_points = 20000;     // most points of the 3D view (the cloud thinned evenly)
     int64_t max_frames = -1;         // > 0: stop after this many frames (measurements)
     bool paused = false;             // start paused (the first frame is shown)
 };
@@ -28,6 +29,7 @@ struct ViewOptions {
 struct ViewSummary {
     int64_t frames = 0;          // processed by the pipeline
     int64_t frames_sent = 0;     // encoded for the browsers
+    double encode_seconds = 0;   // spent encoding them (the viewer's own thread)
     double seconds = 0;          // from the first frame's start to the last frame's end
     double pipeline_fps = 0;     // frames / seconds
     double processing_fps = 0;   // frames / time spent inside the pipeline's steps

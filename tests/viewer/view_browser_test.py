@@ -42,9 +42,16 @@ def wait_for(predicate, timeout, what):
     raise AssertionError(f"timed out after {timeout} s waiting for {what}")
 
 
+# Bad values of the display's options are usage errors naming the option.
+for option, value in (("--cloud-points", "0"), ("--display-fps", "0")):
+    bad = subprocess.run([cli, "view", rig, option, value], capture_output=True, text=True, timeout=60)
+    check(bad.returncode == 2 and option in bad.stderr, f"view {option} {value} is refused: {bad.stderr.strip()[:120]!r}")
+
 # One sample per pixel: the test is about the page, not the renderer's antialiasing.
+DISPLAY_FPS, CLOUD_POINTS = 8, 5000
 view = subprocess.Popen([cli, "view", rig, "--port", "0", "--out", os.path.join(out_dir, "snapshots"),
-                         "--set", "source.antialias=1"],
+                         "--set", "source.antialias=1", "--display-fps", str(DISPLAY_FPS),
+                         "--cloud-points", str(CLOUD_POINTS)],
                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 stderr_lines = []
 threading.Thread(target=lambda: stderr_lines.extend(view.stderr), daemon=True).start()
@@ -115,6 +122,16 @@ try:
         check(size[0] > 0 and size[1] > 0, f"panel {name} shows an image ({size[0]} x {size[1]})")
     cloud_note = driver.find_element("id", "cloud-note").text
     check("points shown" in cloud_note and "ground frame" in cloud_note, f"the 3D view draws the cloud: {cloud_note!r}")
+    shown_points = int(cloud_note.split()[0])
+    check(0 < shown_points <= CLOUD_POINTS < driver.execute_script("return window.binocle.lastHeader.points"),
+          f"--cloud-points bounds the 3D view: {shown_points} of "
+          f"{driver.execute_script('return window.binocle.lastHeader.points')} points")
+    # --display-fps bounds what a page gets (an upper bound: a busy machine only lowers it).
+    got0, t0 = driver.execute_script("return window.binocle.framesReceived"), time.time()
+    time.sleep(3)
+    got1, t1 = driver.execute_script("return window.binocle.framesReceived"), time.time()
+    check(got1 - got0 <= DISPLAY_FPS * (t1 - t0) + 1,
+          f"--display-fps {DISPLAY_FPS}: the page got {got1 - got0} frames in {t1 - t0:.1f} s")
     figures = driver.find_element("id", "figures").text
     check("eta_3d_percent" in figures and "bad_" in figures and "valid pixels" in figures and "match" in figures,
           "the figures show stage times, valid pixels and every evaluator's metrics")

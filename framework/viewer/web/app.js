@@ -6,11 +6,15 @@
 const token = new URLSearchParams(location.search).get('token') || '';
 const $ = (id) => document.getElementById(id);
 // Read by the browser tests: what the page has received.
-window.binocle = { framesReceived: 0, lastHeader: null, lastError: '', state: null, replies: [] };
+// showMs: from a frame's arrival until its images were decoded, summed over the frames
+// received (bench/view_overhead.py reads it).
+window.binocle = { framesReceived: 0, lastHeader: null, lastError: '', state: null, replies: [], showMs: 0 };
 
 let ws = null;
 let colorScale = [];
 let controlsSignature = '';
+let figuresSignature = '';
+let scaleSignature = '';
 const objectUrls = {};
 
 function showMessage(text, info) {
@@ -186,7 +190,18 @@ function markControl(key, message) {
 }
 
 // ---- Frames -----------------------------------------------------------------------
+// Told to the server once a frame's images are decoded: it sends the next frame only then,
+// so this page never gets more frames than it can show (server.hpp). Not after a
+// requestAnimationFrame: a headless or busy browser may hold those back for seconds.
+function shown(images, arrived) {
+  Promise.allSettled(images.map((img) => img.decode())).then(() => {
+    window.binocle.showMs += performance.now() - arrived;
+    send({ op: 'shown' });
+  });
+}
+
 function onFrame(buffer) {
+  const arrived = performance.now();
   const view = new DataView(buffer);
   const length = view.getUint32(0, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
@@ -194,6 +209,7 @@ function onFrame(buffer) {
   base += (4 - (base % 4)) % 4;
   const blob = {};
   for (const b of header.blobs) blob[b.name] = { b, start: base + b.offset };
+  const images = [];
   for (const name of ['left', 'right', 'disparity', 'top', 'front', 'side']) {
     const e = blob[name];
     if (!e) continue;
@@ -203,7 +219,9 @@ function onFrame(buffer) {
     img.dataset.sequence = header.sequence;
     if (objectUrls[name]) URL.revokeObjectURL(objectUrls[name]);
     objectUrls[name] = url;
+    images.push(img);
   }
+  // The 3D view is drawn again only here, when a new cloud has come (or on a drag).
   if (blob.cloud_xyz) {
     const xyz = new Float32Array(buffer.slice(blob.cloud_xyz.start, blob.cloud_xyz.start + blob.cloud_xyz.b.size));
     cloudView.setPoints(xyz, header.cloud.frame);
@@ -216,7 +234,13 @@ function onFrame(buffer) {
   $('fps').textContent = header.pipeline_fps !== null ? `${header.pipeline_fps.toFixed(1)} fps` : '';
   drawScale(header.disparity_scale);
   showFigures(header);
-  $('source-stats').textContent = header.source_statistics || '(the source reports none)';
+  setText($('source-stats'), header.source_statistics || '(the source reports none)');
+  shown(images, arrived);
+}
+
+// Changes the DOM only where the text changed: less for the browser to lay out and paint.
+function setText(element, text) {
+  if (element.textContent !== text) element.textContent = text;
 }
 
 function fmt(v, digits) {
@@ -251,6 +275,13 @@ function showFigures(h) {
     }
   }
   const body = $('figures').tBodies[0];
+  // Same rows as the last frame: only the values change.
+  const signature = JSON.stringify(rows.map(([k, v]) => (k === 'group' ? 'group:' + v : k)));
+  if (signature === figuresSignature) {
+    rows.forEach(([k, v], i) => { if (k !== 'group') setText(body.rows[i].cells[1], v); });
+    return;
+  }
+  figuresSignature = signature;
   body.textContent = '';
   for (const [k, v] of rows) {
     const tr = body.insertRow();
@@ -271,6 +302,9 @@ function showFigures(h) {
 
 // The disparity colour scale, labelled in pixels above and in metres (Z = f·B/d) below.
 function drawScale(s) {
+  const signature = JSON.stringify(s) + colorScale.length;
+  if (signature === scaleSignature) return;
+  scaleSignature = signature;
   const c = $('disparity-scale');
   const g = c.getContext('2d');
   g.clearRect(0, 0, c.width, c.height);
