@@ -104,11 +104,13 @@ def measure(with_browser):
         browser = descendants(driver.service.process.pid) if driver else []
         n0, t0 = frames(port, token)
         v0, b0, m0 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
-        s0 = driver.execute_script("return window.binocle.framesReceived") if driver else 0
+        page = "return [window.binocle.framesReceived, window.binocle.showMs]"
+        s0, ms0 = driver.execute_script(page) if driver else (0, 0)
         time.sleep(args.seconds)
         n1, t1 = frames(port, token)
         v1, b1, m1 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
-        shown = driver.execute_script("return window.binocle.framesReceived") - s0 if driver else 0
+        s1, ms1 = driver.execute_script(page) if driver else (0, 0)
+        shown = s1 - s0
         load = os.getloadavg()[0]
     finally:
         if driver:
@@ -119,7 +121,7 @@ def measure(with_browser):
     cores = os.cpu_count()
     busy = cores * (m1[0] - m0[0]) / max(1, m1[1] - m0[1])
     return {"pipeline_fps": (n1 - n0) / dt, "page_fps": shown / dt, "view_cores": (v1 - v0) / dt,
-            "browser_cores": (b1 - b0) / dt, "machine_busy_cores": busy,
+            "browser_cores": (b1 - b0) / dt, "page_show_ms": (ms1 - ms0) / shown if shown else 0, "machine_busy_cores": busy,
             "others_cores": max(0.0, busy - (v1 - v0) / dt - (b1 - b0) / dt), "load_1min": load}
 
 
@@ -151,6 +153,9 @@ result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "rounds
           "view_cores_without": round(med("without", "view_cores"), 2),
           "view_cores_with": round(med("with", "view_cores"), 2),
           "browser_cores": round(med("with", "browser_cores"), 2),
+          "browser_cpu_ms_per_page_frame": round(1000 * med("with", "browser_cores") / med("with", "page_fps"), 1)
+          if med("with", "page_fps") > 0 else None,
+          "page_show_ms": round(med("with", "page_show_ms"), 1),
           "others_cores_without": round(med("without", "others_cores"), 2),
           "others_cores_with": round(med("with", "others_cores"), 2)}
 print(json.dumps(result))

@@ -234,9 +234,9 @@ private:
             fps = recent_.size() > 1 && span > 0 ? (recent_.size() - 1) / span : 0;
         }
         const int64_t processed = ++processed_;
-        if (server_->browsers() == 0) return;
         // While paused, the frames still in flight and a stepped one are what the user
-        // waits for: each replaces the one waiting, whatever the browsers are doing.
+        // waits for (now, or when a page opens): each replaces the one waiting, whatever
+        // the browsers are doing.
         const bool paused = pausedNow_;
         if (!paused && (encoderBusy_ || now - lastHandOver_.load() < minInterval_ || !server_->wantsFrame())) return;
         auto p = std::make_shared<FrameProducts>(copyFrame(r));

@@ -19,7 +19,7 @@ struct ViewOptions {
     std::string address = "127.0.0.1";
     int port = 8080;                 // 0: any free port
     std::string out_dir = "out/view"; // where snapshots go
-    double display_fps = 10;         // most frames per second sent to the browsers
+    double display_fps = 5;          // most frames per second sent to the browsers
     size_t cloud_points = 20000;     // most points of the 3D view (the cloud thinned evenly)
     int64_t max_frames = -1;         // > 0: stop after this many frames (measurements)
     bool paused = false;             // start paused (the first frame is shown)
