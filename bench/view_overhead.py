@@ -8,7 +8,7 @@
 # machine (other users of a shared box included), in cores (1.0 = one core busy).
 #
 # usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10]
-#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--json FILE]
+#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--json FILE]
 #   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH (absolute) as for the CLI.
 # Run it inside scripts/netns-test.sh to keep everything on loopback.
 import argparse
@@ -33,6 +33,9 @@ parser.add_argument("--warmup", type=float, default=3)
 parser.add_argument("--set", action="append", default=[])
 parser.add_argument("--view-arg", action="append", default=[], help="more arguments for `binocle view`")
 parser.add_argument("--json", help="also write the medians and every round here")
+parser.add_argument("--page-draws-nothing", action="store_true",
+                    help="the page takes and acknowledges every frame but draws none: the viewer's own cost "
+                         "(copy, encoding, sending) without the browser's rendering")
 args = parser.parse_args()
 cli = os.environ.get("BINOCLE_CLI", os.path.join(root, "build/bin/binocle"))
 TICK = os.sysconf("SC_CLK_TCK")
@@ -100,6 +103,8 @@ def measure(with_browser):
             end = time.time() + 60
             while driver.execute_script("return window.binocle.framesReceived") < 1 and time.time() < end:
                 time.sleep(0.1)
+            if args.page_draws_nothing:  # the page's frame handler, replaced by a count and the acknowledgement
+                driver.execute_script("onFrame = function () { window.binocle.framesReceived += 1; send({op: 'shown'}); };")
         time.sleep(args.warmup)
         browser = descendants(driver.service.process.pid) if driver else []
         n0, t0 = frames(port, token)
@@ -143,7 +148,7 @@ def med(which, key):
 
 
 ratios = [x["with"]["pipeline_fps"] / x["without"]["pipeline_fps"] for x in rounds if x["without"]["pipeline_fps"] > 0]
-result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "rounds": args.rounds, "window_s": args.seconds,
+result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_draws_nothing": args.page_draws_nothing, "rounds": args.rounds, "window_s": args.seconds,
           "cores": os.cpu_count(),
           "fps_without_browser": round(med("without", "pipeline_fps"), 2),
           "fps_with_browser": round(med("with", "pipeline_fps"), 2),
