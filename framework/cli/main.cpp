@@ -4,6 +4,7 @@
 #include "config/rig_config.hpp"
 #include "core/log.hpp"
 #include "input/image_file.hpp"
+#include "input/text.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -35,7 +36,7 @@ std::string extrasMessage(const CLI::App &app, const std::vector<std::string> &e
         std::vector<std::string> bare;
         const std::vector<std::string> names = optionNames(app);
         for (const auto &n : names) bare.push_back(n.substr(n.find_first_not_of('-')));
-        const std::string hint = nearest(name.substr(name.find_first_not_of('-')), bare);
+        const std::string hint = input::nearestWord(name.substr(name.find_first_not_of('-')), bare);
         std::string suggestion;
         for (size_t i = 0; i < bare.size() && !hint.empty(); ++i)
             if (bare[i] == hint) suggestion = names[i];
@@ -106,7 +107,7 @@ int main(int argc, char **argv) {
         }
         std::vector<std::string> names;
         for (const auto &[name, c] : commands()) names.push_back(name);
-        const std::string hint = nearest(extras.front(), names);
+        const std::string hint = input::nearestWord(extras.front(), names);
         spdlog::error("unknown command '{}'{} (see `binocle --help`)", extras.front(),
                       hint.empty() ? "" : "; did you mean '" + hint + "'?");
         return kExitUsage;

@@ -34,34 +34,6 @@ Override Override::parse(const std::string &text) {
     return o;
 }
 
-std::string nearest(const std::string &word, const std::vector<std::string> &candidates) {
-    auto distance = [](const std::string &a, const std::string &b) {
-        std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
-        for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-        for (size_t i = 1; i <= a.size(); ++i) {
-            cur[0] = i;
-            for (size_t j = 1; j <= b.size(); ++j)
-                cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-            std::swap(prev, cur);
-        }
-        return prev[b.size()];
-    };
-    auto commonPrefix = [](const std::string &a, const std::string &b) {
-        size_t n = 0;
-        while (n < a.size() && n < b.size() && a[n] == b[n]) ++n;
-        return n;
-    };
-    std::string best;
-    size_t bestD = std::max<size_t>(2, word.size() / 3) + 1, bestPrefix = 0;
-    for (const auto &c : candidates) {
-        const size_t d = distance(word, c), prefix = commonPrefix(word, c);
-        // Ties go to the longer common prefix: "num_disparity" -> "num_disparities",
-        // not "min_disparity".
-        if (d < bestD || (d == bestD && !best.empty() && prefix > bestPrefix)) bestD = d, best = c, bestPrefix = prefix;
-    }
-    return best;
-}
-
 namespace {
 
 std::vector<std::string> splitPath(const std::string &path) {
@@ -123,7 +95,6 @@ std::string flowText(const YAML::Node &n) {
 }
 
 // A map key as text; a non-scalar key (YAML allows "? [a, b]") is named, not converted.
-std::string keyText(const YAML::Node &k) { return k.IsScalar() ? k.Scalar() : "(" + scalarText(k) + " as a key)"; }
 
 std::string describeChoices(const binocle_param_desc &d) {
     std::string c = d.choices ? d.choices : "";
@@ -192,7 +163,7 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
         std::stringstream ss(choices);
         for (std::string c; std::getline(ss, c, '|');) list.push_back(c);
         if (!n.IsScalar() || std::find(list.begin(), list.end(), n.Scalar()) == list.end()) {
-            std::string hint = n.IsScalar() ? nearest(n.Scalar(), list) : "";
+            std::string hint = n.IsScalar() ? input::nearestWord(n.Scalar(), list) : "";
             bad("one of " + describeChoices(d) + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
         }
         out.setText(d.name, d.type, n.Scalar(), isExplicit);
@@ -271,17 +242,13 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
     if (block.IsDefined() && !block.IsNull() && !block.IsMap())
         ctx.fail(block, where, "expected a map of settings for plugin '" + record.name + "'");
     if (block.IsMap()) {
-        for (const auto &kv : block) {
-            const std::string key = keyText(kv.first);
-            if (std::find(kBlockKeys.begin(), kBlockKeys.end(), key) != kBlockKeys.end()) continue;
-            if (std::find(names.begin(), names.end(), key) != names.end()) continue;
-            std::string hint = nearest(key, names);
-            std::string all;
-            for (const auto &n : names) all += (all.empty() ? "" : ", ") + n;
-            throw Error(ctx.at(kv.first, where + "." + key).str() + ": " + where + ": unknown key '" + key + "' for plugin '" +
-                        record.name + "'" + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                        " (valid keys: " + (all.empty() ? "none" : all) + ")");
-        }
+        // The block's own keys (plugin, isolation, ...) are valid too, but the message lists the plugin's.
+        YAML::Node settingsOnly(YAML::NodeType::Map);
+        for (const auto &kv : block)
+            if (!kv.first.IsScalar() || std::find(kBlockKeys.begin(), kBlockKeys.end(), kv.first.Scalar()) == kBlockKeys.end())
+                settingsOnly.force_insert(kv.first, kv.second);
+        if (auto unknown = input::findUnknownKey(settingsOnly, names, "for plugin '" + record.name + "'"))
+            throw Error(ctx.at(unknown->key, where + "." + unknown->name).str() + ": " + where + ": " + unknown->message);
     }
     ParamValues values;
     for (const auto &d : descs) {
@@ -319,19 +286,13 @@ RuntimeOptions runtimeBlock(const YAML::Node &r, const Context &ctx) {
     RuntimeOptions rt;
     if (!r.IsDefined() || r.IsNull()) return rt;
     if (!r.IsMap()) ctx.fail(r, "runtime", "expected a map (policy: lossless, queue_depth: 4, ...)");
-    for (const auto &kv : r) {
-        const std::string key = kv.first.as<std::string>();
-        if (std::find(kRuntimeKeys.begin(), kRuntimeKeys.end(), key) != kRuntimeKeys.end()) continue;
-        std::string hint = nearest(key, kRuntimeKeys);
-        throw Error(ctx.at(kv.first, "runtime." + key).str() + ": runtime: unknown key '" + key + "'" +
-                    (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                    " (valid keys: policy, queue_depth, matcher_instances, on_source_error, retry_for_s)");
-    }
+    if (auto unknown = input::findUnknownKey(r, kRuntimeKeys))
+        throw Error(ctx.at(unknown->key, "runtime." + unknown->name).str() + ": runtime: " + unknown->message);
     auto choice = [&](const char *key, const std::vector<std::string> &choices) -> std::optional<std::string> {
         YAML::Node n = r[key];
         if (!n || n.IsNull()) return std::nullopt;
         if (n.IsScalar() && std::find(choices.begin(), choices.end(), n.Scalar()) != choices.end()) return n.Scalar();
-        std::string all, hint = n.IsScalar() ? nearest(n.Scalar(), choices) : "";
+        std::string all, hint = n.IsScalar() ? input::nearestWord(n.Scalar(), choices) : "";
         for (const auto &c : choices) all += (all.empty() ? "" : ", ") + c;
         ctx.fail(n, std::string("runtime.") + key, "value '" + scalarText(n) + "' is not valid: expected one of " + all +
                                                       (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
@@ -392,7 +353,7 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
         std::vector<std::string> names;
         for (const auto &r : host.plugins())
             if (r.kind == kind) names.push_back(r.name);
-        std::string hint = nearest(b.plugin, names), all;
+        std::string hint = input::nearestWord(b.plugin, names), all;
         for (const auto &n : names) all += (all.empty() ? "" : ", ") + n;
         std::string refused;
         for (const auto &r : host.refused())
@@ -418,14 +379,8 @@ std::vector<PluginBlock> blockList(const YAML::Node &node, const std::string &wh
 
 RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &host) {
     if (!root.IsMap()) throw Error(ctx.file + ": expected a YAML map with source, matcher, ... at the top level");
-    for (const auto &kv : root) {
-        const std::string key = keyText(kv.first);
-        if (std::find(kTopKeys.begin(), kTopKeys.end(), key) != kTopKeys.end()) continue;
-        std::string hint = nearest(key, kTopKeys);
-        throw Error(ctx.at(kv.first, key).str() + ": unknown key '" + key + "'" +
-                    (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                    " (valid keys: name, description, source, calibration, matcher, transforms, evaluators, outputs, runtime)");
-    }
+    if (auto unknown = input::findUnknownKey(root, kTopKeys))
+        throw Error(ctx.at(unknown->key, unknown->name).str() + ": " + unknown->message);
     RigConfig rig;
     rig.file = ctx.file;
     rig.base_dir = ctx.base_dir;
@@ -448,15 +403,8 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     }
     if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
         if (!o.IsMap()) ctx.fail(o, "outputs", "expected a map (disparity_png: true, ...)");
-        for (const auto &kv : o) {
-            const std::string key = keyText(kv.first);
-            if (std::find(kOutputKeys.begin(), kOutputKeys.end(), key) == kOutputKeys.end()) {
-                std::string hint = nearest(key, kOutputKeys);
-                throw Error(ctx.at(kv.first, "outputs." + key).str() + ": outputs: unknown key '" + key + "'" +
-                            (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                            " (valid keys: disparity_png, disparity_color, disparity_pfm, cloud_ply, rectified_png, max_range_mm)");
-            }
-        }
+        if (auto unknown = input::findUnknownKey(o, kOutputKeys))
+            throw Error(ctx.at(unknown->key, "outputs." + unknown->name).str() + ": outputs: " + unknown->message);
         auto flag = [&](const char *key, bool &v) {
             YAML::Node n = o[key];
             if (!n) return;

@@ -93,7 +93,4 @@ ParamValues resolveParams(const PluginRecord &record, const YAML::Node &block, c
 // All defaults of a plugin, plus the given YAML text (a map) on top: handy for tests.
 ParamValues paramsFromYaml(const PluginRecord &record, const std::string &yaml = "{}");
 
-// Closest candidate by edit distance, or "" when none is close.
-std::string nearest(const std::string &word, const std::vector<std::string> &candidates);
-
 } // namespace binocle

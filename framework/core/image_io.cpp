@@ -58,47 +58,27 @@ cv::Mat readDisparityPng16(const std::string &path) {
 
 void writePfm(const std::string &path, const cv::Mat &image) {
     CV_Assert(image.depth() == CV_32F && (image.channels() == 1 || image.channels() == 3));
-    std::ostringstream os;
-    os << (image.channels() == 3 ? "PF" : "Pf") << "\n" << image.cols << " " << image.rows << "\n-1.0\n";
-    std::string bytes = os.str();
-    const size_t rowBytes = static_cast<size_t>(image.cols) * image.channels() * sizeof(float);
-    for (int v = image.rows - 1; v >= 0; --v) {
-        std::string row(reinterpret_cast<const char *>(image.ptr(v)), rowBytes);
-        if (image.channels() == 1) {
-            float *f = reinterpret_cast<float *>(row.data());
-            for (int u = 0; u < image.cols; ++u)
-                if (!(f[u] > 0) && std::isfinite(f[u])) f[u] = std::numeric_limits<float>::infinity();
-        }
-        bytes += row;
+    cv::Mat out = image;
+    if (image.channels() == 1) {
+        // A disparity map: invalid (<= 0) pixels become inf, as Middlebury's PFM files mark them.
+        out = image.clone();
+        out.setTo(std::numeric_limits<float>::infinity(), ~(image > 0) & (image == image));
     }
-    writeFileAtomic(path, bytes);
+    std::vector<uchar> bytes;
+    try {
+        if (!cv::imencode(".pfm", out, bytes)) throw Error(path + ": cannot encode PFM");
+    } catch (const cv::Exception &e) {
+        throw Error(path + ": cannot encode PFM: " + e.err);
+    }
+    writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
 cv::Mat readPfm(const std::string &path) {
-    // The header is checked against the image limits and the file's size before
-    // anything is allocated: a 20-byte file claiming 65536 x 65536 is refused at once.
-    std::vector<uint8_t> bytes;
-    input::ImageInfo info;
-    std::string problem;
     try {
-        bytes = input::readImageFileBytes(path, "PFM file");
+        return input::readPfm(path);
     } catch (const input::ImageFileError &e) {
         throw Error(e.what());
     }
-    if (!input::inspectImage(bytes.data(), bytes.size(), info, problem)) throw Error("PFM file '" + path + "': " + problem);
-    if (info.format != "pfm") throw Error(path + ": not a PFM file (expected 'Pf' or 'PF', width, height, scale)");
-    const int w = static_cast<int>(info.width), h = static_cast<int>(info.height), ch = info.channels;
-    cv::Mat m(h, w, CV_32FC(ch));
-    const bool bigEndian = info.scale > 0;
-    const size_t rowBytes = static_cast<size_t>(w) * ch * sizeof(float);
-    for (int v = h - 1, r = 0; v >= 0; --v, ++r) {
-        std::memcpy(m.ptr(v), bytes.data() + info.dataOffset + rowBytes * static_cast<size_t>(r), rowBytes);
-        if (bigEndian) {
-            auto *b = m.ptr(v);
-            for (int i = 0; i < w * ch; ++i) std::swap(b[4 * i], b[4 * i + 3]), std::swap(b[4 * i + 1], b[4 * i + 2]);
-        }
-    }
-    return m;
 }
 
 cv::Mat colorizeDisparity(const cv::Mat &disparity, double max_disparity) {

@@ -78,13 +78,7 @@ struct Reader {
     [[noreturn]] void fail(const YAML::Node &n, const std::string &what) const { throw Error(where(n) + ": " + what); }
     void checkKeys(const YAML::Node &map, const std::vector<std::string> &valid, const std::string &what) const {
         if (!map.IsMap()) fail(map, what + ": expected a map");
-        for (const auto &kv : map) {
-            const std::string k = key(kv.first);
-            if (std::find(valid.begin(), valid.end(), k) != valid.end()) continue;
-            const std::string hint = nearest(k, valid);
-            fail(kv.first, what + ": unknown key '" + k + "'" + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
-                               " (valid keys: " + join(valid) + ")");
-        }
+        if (auto unknown = input::findUnknownKey(map, valid)) fail(unknown->key, what + ": " + unknown->message);
     }
     // One strict reader of numbers (input/numbers.hpp): decimal, finite.
     double number(const YAML::Node &n, const std::string &what) const {
@@ -304,7 +298,7 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
         const Override o = Override::parse(text);
         const std::string top = o.path.substr(0, o.path.find('.'));
         if (std::find(kTopKeys.begin(), kTopKeys.end(), top) == kTopKeys.end()) {
-            const std::string hint = nearest(top, kTopKeys);
+            const std::string hint = input::nearestWord(top, kTopKeys);
             throw Error("--set " + text + ": the experiment has no key '" + top + "'" +
                         (hint.empty() ? "" : "; did you mean '" + hint + "'?") + " (valid keys: " + join(kTopKeys) + ")");
         }

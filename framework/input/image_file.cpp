@@ -248,21 +248,38 @@ std::vector<uint8_t> readImageFileBytes(const std::string &path, const std::stri
     return bytes;
 }
 
-cv::Mat readImage(const std::string &path, int flags, const std::string &what, const ImageLimits &limits) {
-    const std::vector<uint8_t> bytes = readImageFileBytes(path, what, limits);
-    const std::string name = what + " '" + path + "'";
+cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::string &name, const ImageLimits &limits) {
     ImageInfo info;
     std::string problem;
-    if (!inspectImage(bytes.data(), bytes.size(), info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
+    if (!inspectImage(data, size, info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
     cv::Mat m;
     try {
-        m = cv::imdecode(bytes, flags);
+        m = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t *>(data)), flags);
     } catch (const cv::Exception &e) {
         throw ImageFileError(name + ": cannot decode: " + e.err, false);
     }
     if (m.empty())
         throw ImageFileError(name + ": cannot decode" + (info.format.empty() ? ": not an image format OpenCV reads" : " the " + info.format + " data"), false);
     return m;
+}
+
+cv::Mat readImage(const std::string &path, int flags, const std::string &what, const ImageLimits &limits) {
+    const std::vector<uint8_t> bytes = readImageFileBytes(path, what, limits);
+    return decodeImage(bytes.data(), bytes.size(), flags, what + " '" + path + "'", limits);
+}
+
+cv::Mat readPfm(const std::string &path, const std::string &what, const ImageLimits &limits) {
+    const std::vector<uint8_t> bytes = readImageFileBytes(path, what, limits);
+    return decodePfm(bytes.data(), bytes.size(), what + " '" + path + "'", limits);
+}
+
+cv::Mat decodePfm(const uint8_t *data, size_t size, const std::string &name, const ImageLimits &limits) {
+    ImageInfo info;
+    std::string problem;
+    if (!inspectImage(data, size, info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
+    if (info.format != "pfm")
+        throw ImageFileError(name + ": not a PFM file (expected a header 'Pf' or 'PF', width, height and a non-zero scale)", false);
+    return decodeImage(data, size, cv::IMREAD_UNCHANGED, name, limits);
 }
 
 } // namespace binocle::input

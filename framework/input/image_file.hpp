@@ -64,4 +64,14 @@ std::vector<uint8_t> readImageFileBytes(const std::string &path, const std::stri
 cv::Mat readImage(const std::string &path, int flags, const std::string &what = "image",
                   const ImageLimits &limits = {});
 
+// The same from bytes in memory; `name` starts every message ("left image 'x.png'").
+cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::string &name, const ImageLimits &limits = {});
+
+// Portable Float Map, the one PFM path of Binocle: the header is checked against the
+// limits and the data's size before anything is allocated, then OpenCV's own codec
+// decodes it. "Pf" gives CV_32FC1, "PF" CV_32FC3 in OpenCV's BGR order; top row first,
+// values as stored (inf stays inf). Anything else is refused (ImageFileError).
+cv::Mat readPfm(const std::string &path, const std::string &what = "PFM file", const ImageLimits &limits = {});
+cv::Mat decodePfm(const uint8_t *data, size_t size, const std::string &name, const ImageLimits &limits = {});
+
 } // namespace binocle::input

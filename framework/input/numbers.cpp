@@ -2,6 +2,8 @@
 // The one strict reader of numbers in untrusted text.
 #include "input/numbers.hpp"
 
+#include <binocle/text.hpp>
+
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -22,26 +24,8 @@ bool fail(std::string *why, const std::string &text) {
 } // namespace
 
 bool parseInteger(std::string_view text, int64_t &out, std::string *why, int64_t min, int64_t max) {
-    size_t i = 0;
-    const bool negative = !text.empty() && text[0] == '-';
-    if (!text.empty() && (text[0] == '-' || text[0] == '+')) i = 1;
-    if (i == text.size()) return fail(why, "expected a decimal integer");
-    for (size_t k = i; k < text.size(); ++k)
-        if (!isDigit(text[k])) return fail(why, "expected a decimal integer");
-    if (text[i] == '0' && text.size() - i > 1)
-        return fail(why, "expected a decimal integer without leading zeros (0" + std::string(text.substr(i + 1)) +
-                             " would read as octal elsewhere)");
-    // Accumulate as a negative number: INT64_MIN has no positive counterpart.
     int64_t v = 0;
-    for (size_t k = i; k < text.size(); ++k) {
-        const int d = text[k] - '0';
-        if (v < (INT64_MIN + d) / 10) return fail(why, "expected an integer within 64 bits");
-        v = v * 10 - d;
-    }
-    if (!negative) {
-        if (v == INT64_MIN) return fail(why, "expected an integer within 64 bits");
-        v = -v;
-    }
+    if (!sdk::parseDecimalInteger(text, v, why)) return false;
     if (v < min) return fail(why, "expected an integer >= " + std::to_string(min));
     if (v > max) return fail(why, "expected an integer <= " + std::to_string(max));
     out = v;

@@ -1,42 +1,20 @@
 // SPDX-License-Identifier: MIT
-// UTF-8 validity, printable excerpts, confined paths and safe names.
+// UTF-8 validity, safe names and the nearest word (printable excerpts and confined
+// paths are the SDK's, binocle/text.hpp).
 #include "input/text.hpp"
 
+#include <binocle/text.hpp>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdint>
+#include <vector>
 
 namespace binocle::input {
 
-namespace {
-
-// Length of the well-formed UTF-8 sequence at text[i], 0 when ill-formed (RFC 3629).
-size_t sequenceLength(std::string_view text, size_t i) {
-    const auto byte = [&](size_t k) { return static_cast<uint8_t>(text[k]); };
-    const uint8_t c = byte(i);
-    if (c < 0x80) return 1;
-    size_t n = 0;
-    uint8_t lo = 0x80, hi = 0xBF; // allowed range of the second byte
-    if (c >= 0xC2 && c <= 0xDF) n = 2;
-    else if (c == 0xE0) n = 3, lo = 0xA0;
-    else if (c >= 0xE1 && c <= 0xEC) n = 3;
-    else if (c == 0xED) n = 3, hi = 0x9F; // no surrogates
-    else if (c >= 0xEE && c <= 0xEF) n = 3;
-    else if (c == 0xF0) n = 4, lo = 0x90;
-    else if (c >= 0xF1 && c <= 0xF3) n = 4;
-    else if (c == 0xF4) n = 4, hi = 0x8F; // <= U+10FFFF
-    else return 0;
-    if (i + n > text.size()) return 0;
-    if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
-    for (size_t k = 2; k < n; ++k)
-        if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
-    return n;
-}
-
-} // namespace
-
 bool isValidUtf8(std::string_view text, size_t *badOffset) {
     for (size_t i = 0; i < text.size();) {
-        const size_t n = sequenceLength(text, i);
+        const size_t n = sdk::utf8SequenceLength(text, i);
         if (n == 0) {
             if (badOffset) *badOffset = i;
             return false;
@@ -50,7 +28,7 @@ std::string sanitizeUtf8(std::string_view text) {
     std::string out;
     out.reserve(text.size());
     for (size_t i = 0; i < text.size();) {
-        const size_t n = sequenceLength(text, i);
+        const size_t n = sdk::utf8SequenceLength(text, i);
         if (n == 0) {
             out += "\xEF\xBF\xBD";
             ++i;
@@ -60,48 +38,6 @@ std::string sanitizeUtf8(std::string_view text) {
         }
     }
     return out;
-}
-
-std::string printable(std::string_view text, size_t maxChars) {
-    std::string out;
-    size_t chars = 0, i = 0;
-    for (; i < text.size() && chars < maxChars; ++chars) {
-        const size_t n = sequenceLength(text, i);
-        const auto c = static_cast<uint8_t>(text[i]);
-        char buf[8];
-        if (n == 0 || c < 0x20 || c == 0x7F) {
-            if (c == '\n') out += "\\n";
-            else if (c == '\t') out += "\\t";
-            else {
-                std::snprintf(buf, sizeof buf, "\\x%02X", c);
-                out += buf;
-            }
-            ++i;
-        } else {
-            out.append(text.substr(i, n));
-            i += n;
-        }
-    }
-    if (i < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
-    return out;
-}
-
-bool isConfinedRelativePath(std::string_view path, std::string *why) {
-    auto fail = [&](const char *what) {
-        if (why) *why = what;
-        return false;
-    };
-    if (path.empty()) return fail("empty path");
-    if (path.find('\0') != std::string_view::npos) return fail("the path holds a NUL byte");
-    if (path.front() == '/') return fail("absolute path; expected a path relative to the folder");
-    size_t start = 0;
-    while (start <= path.size()) {
-        size_t end = path.find('/', start);
-        if (end == std::string_view::npos) end = path.size();
-        if (path.substr(start, end - start) == "..") return fail("'..' leads out of the folder");
-        start = end + 1;
-    }
-    return true;
 }
 
 bool isSafeName(std::string_view name, std::string *why) {
@@ -118,6 +54,34 @@ bool isSafeName(std::string_view name, std::string *why) {
     }
     if (name.front() == '.') return fail("starts with '.'");
     return true;
+}
+
+std::string nearestWord(const std::string &word, const std::vector<std::string> &candidates) {
+    auto distance = [](const std::string &a, const std::string &b) {
+        std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            cur[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j)
+                cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            std::swap(prev, cur);
+        }
+        return prev[b.size()];
+    };
+    auto commonPrefix = [](const std::string &a, const std::string &b) {
+        size_t n = 0;
+        while (n < a.size() && n < b.size() && a[n] == b[n]) ++n;
+        return n;
+    };
+    std::string best;
+    size_t bestD = std::max<size_t>(2, word.size() / 3) + 1, bestPrefix = 0;
+    for (const auto &c : candidates) {
+        const size_t d = distance(word, c), prefix = commonPrefix(word, c);
+        // Ties go to the longer common prefix: "num_disparity" -> "num_disparities",
+        // not "min_disparity".
+        if (d < bestD || (d == bestD && !best.empty() && prefix > bestPrefix)) bestD = d, best = c, bestPrefix = prefix;
+    }
+    return best;
 }
 
 } // namespace binocle::input

@@ -3,9 +3,12 @@
 // confinement of paths to a folder.
 #pragma once
 
+#include <binocle/text.hpp>
+
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace binocle::input {
 
@@ -18,15 +21,19 @@ std::string sanitizeUtf8(std::string_view text);
 
 // The text for an error message: ill-formed bytes as \xNN, control characters escaped,
 // cut after `maxChars` characters with "... (N bytes)".
-std::string printable(std::string_view text, size_t maxChars = 80);
+using sdk::printable; // sdk/include/binocle/text.hpp, shared with plugins
 
 // A relative path that stays inside the folder it is relative to: not empty, not
 // absolute, no ".." component, no NUL. "left/000001.png" yes; "../x", "/etc/passwd",
 // "a/../../b" no. `why` says what is wrong.
-bool isConfinedRelativePath(std::string_view path, std::string *why = nullptr);
+using sdk::isConfinedRelativePath;
 
 // A name usable as one file-name component: 1..100 characters of [A-Za-z0-9._-], not
 // starting with '.' ("1", "e1-b150_f8" yes; "../x", "/x", ".", "a b" no).
 bool isSafeName(std::string_view name, std::string *why = nullptr);
+
+// The candidate closest to `word` by edit distance (ties: the longer common prefix),
+// or "" when none is close: the "did you mean" of every message about a name.
+std::string nearestWord(const std::string &word, const std::vector<std::string> &candidates);
 
 } // namespace binocle::input

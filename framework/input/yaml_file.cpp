@@ -97,4 +97,30 @@ YAML::Node loadYamlFile(const std::string &path, uint64_t maxBytes) {
     return parseYaml(text.str(), path);
 }
 
+std::optional<UnknownKey> findUnknownKey(const YAML::Node &map, const std::vector<std::string> &valid,
+                                         const std::string &owner) {
+    if (!map.IsMap()) return std::nullopt;
+    for (const auto &kv : map) {
+        const std::string name = kv.first.IsScalar() ? kv.first.Scalar() : "(a non-scalar key)";
+        if (std::find(valid.begin(), valid.end(), name) != valid.end()) continue;
+        const std::string hint = kv.first.IsScalar() ? nearestWord(name, valid) : "";
+        std::string list;
+        for (const auto &v : valid) list += (list.empty() ? "" : ", ") + v;
+        return UnknownKey{kv.first, name,
+                          "unknown key '" + printable(name, 60) + "'" + (owner.empty() ? "" : " " + owner) + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                              " (valid keys: " + (list.empty() ? "none" : list) + ")"};
+    }
+    return std::nullopt;
+}
+
+void checkKeys(const YAML::Node &map, const std::vector<std::string> &valid, const std::string &what,
+               const std::string &origin) {
+    if (!map.IsMap()) throw YamlError(located(map, origin) + ": " + what + ": expected a map");
+    if (auto unknown = findUnknownKey(map, valid)) throw YamlError(located(unknown->key, origin) + ": " + what + ": " + unknown->message);
+}
+
+std::string located(const YAML::Node &node, const std::string &origin) {
+    return node.IsDefined() ? at(origin, node.Mark()) : origin;
+}
+
 } // namespace binocle::input

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
-// Recording a rig's source to a folder in the `recording` layout of plugins/replay/README.md.
+// Recording a rig's source to a folder in the recording format (sdk/include/binocle/recording.hpp):
+// the layout, frames.csv and the durability rules are the SDK's; this adds the writer pool.
 #include "pipeline/recorder.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
+
+#include <binocle/recording.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -29,20 +32,6 @@ namespace fs = std::filesystem;
 namespace binocle {
 
 namespace {
-
-constexpr const char *kCsvHeader = "sequence,timestamp_left_ns,timestamp_right_ns,left,right\n";
-
-// Writes all of `text` to `fd` and makes it durable; throws naming `path`.
-void writeDurably(int fd, const std::string &text, const std::string &path) {
-    size_t done = 0;
-    while (done < text.size()) {
-        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) throw Error("cannot write " + path + ": " + std::strerror(errno));
-        done += static_cast<size_t>(n);
-    }
-    if (::fsync(fd) != 0) throw Error("cannot write " + path + ": fsync failed: " + std::strerror(errno));
-}
 
 std::string listed(const fs::path &dir) {
     std::vector<std::string> names;
@@ -69,12 +58,6 @@ cv::Mat view(const binocle_image &im, bool &rgb) {
 }
 
 } // namespace
-
-std::string RecordingWriter::imagePath(const std::string &side, uint64_t sequence) {
-    char name[32];
-    std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(sequence));
-    return side + "/" + name;
-}
 
 // The writer's threads: `threads` workers encode and write images, one committer appends
 // rows in submission order once their images are durable.
@@ -139,7 +122,7 @@ struct RecordingWriter::Pool {
 
     void writeImages(Job &job, double &encodeMs, double &writeMs) const {
         for (int i = 0; i < 2; ++i) {
-            const std::string file = (fs::path(dir) / imagePath(i == 0 ? "left" : "right", job.sequence)).string();
+            const std::string file = (fs::path(dir) / recording::imagePath(i, job.sequence)).string();
             const auto t0 = std::chrono::steady_clock::now();
             cv::Mat toWrite = job.images[i];
             if (job.rgb && toWrite.channels() == 3) cv::cvtColor(toWrite, toWrite, cv::COLOR_RGB2BGR);
@@ -207,15 +190,9 @@ struct RecordingWriter::Pool {
     }
 
     void writeRows(const std::vector<std::shared_ptr<Job>> &batch) {
-        // The renames of the batch's images are durable before any row names them.
-        for (int i = 0; i < 2; ++i)
-            if (::fsync(dirFds[i]) != 0)
-                throw Error("record: cannot write " + dir + (i == 0 ? "/left" : "/right") + ": fsync failed: " + std::strerror(errno));
-        std::string lines;
-        for (const auto &job : batch)
-            lines += std::to_string(job->sequence) + "," + std::to_string(job->tl) + "," + std::to_string(job->tr) + "," +
-                     imagePath("left", job->sequence) + "," + imagePath("right", job->sequence) + "\n";
-        writeDurably(csvFd, lines, csvPath);
+        std::vector<recording::Row> rows;
+        for (const auto &job : batch) rows.push_back(recording::rowFor(job->sequence, job->tl, job->tr));
+        recording::appendRowsDurably(csvFd, dirFds, rows, dir);
     }
 
     void rethrow() const {
@@ -248,21 +225,21 @@ RecordingWriter::RecordingWriter(const std::string &dir, const std::string &cali
             throw Error("record: " + dir_ + " is not empty (it holds " + listed(dir_) +
                         "): refusing to record over it; choose a new folder");
     }
-    fs::create_directories(fs::path(dir_) / "left", ec);
-    if (!ec) fs::create_directories(fs::path(dir_) / "right", ec);
+    fs::create_directories(fs::path(dir_) / recording::kSideFolders[0], ec);
+    if (!ec) fs::create_directories(fs::path(dir_) / recording::kSideFolders[1], ec);
     if (ec) throw Error("record: cannot create " + dir_ + ": " + ec.message());
-    if (!calibrationYaml.empty()) writeFileAtomic((fs::path(dir_) / "calibration.yml").string(), calibrationYaml);
-    if (!rigYaml.empty()) writeFileAtomic((fs::path(dir_) / "rig.yaml").string(), rigYaml);
+    if (!calibrationYaml.empty()) writeFileAtomic((fs::path(dir_) / recording::kCalibrationFile).string(), calibrationYaml);
+    if (!rigYaml.empty()) writeFileAtomic((fs::path(dir_) / recording::kRigFile).string(), rigYaml);
     for (int i = 0; i < 2; ++i) {
-        const std::string side = (fs::path(dir_) / (i == 0 ? "left" : "right")).string();
+        const std::string side = (fs::path(dir_) / recording::kSideFolders[i]).string();
         p.dirFds[i] = ::open(side.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (p.dirFds[i] < 0) throw Error("record: cannot open " + side + ": " + std::strerror(errno));
     }
-    p.csvPath = (fs::path(dir_) / "frames.csv").string();
+    p.csvPath = (fs::path(dir_) / recording::kIndexFile).string();
     // O_EXCL: even a recorder racing for the same folder cannot truncate another's index.
     p.csvFd = ::open(p.csvPath.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_APPEND | O_CLOEXEC, 0644);
     if (p.csvFd < 0) throw Error("record: cannot create " + p.csvPath + ": " + std::strerror(errno));
-    writeDurably(p.csvFd, kCsvHeader, p.csvPath);
+    recording::appendDurably(p.csvFd, recording::kIndexHeader, p.csvPath);
 
     for (int i = 0; i < p.options.threads; ++i) p.workers.emplace_back([&p] { p.work(); });
     p.committer = std::thread([&p] { p.commitLoop(); });

@@ -81,8 +81,6 @@ public:
     const std::string &dir() const { return dir_; }
     RecordingWriterStats stats() const;
 
-    // Image file of a frame, relative to the folder: "left/000017.png".
-    static std::string imagePath(const std::string &side, uint64_t sequence);
 
 private:
     struct Pool;

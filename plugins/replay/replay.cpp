@@ -12,6 +12,7 @@
 #include "input/text.hpp"
 
 #include <binocle/plugin.hpp>
+#include <binocle/recording.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -466,27 +467,32 @@ Plan planKitti(const Settings &s, const sdk::Host &host) {
 
 Plan planRecording(const Settings &s, const sdk::Host &host) {
     const fs::path folder = s.folder;
-    const fs::path csv = folder / "frames.csv";
+    const fs::path csv = folder / recording::kIndexFile;
     if (!fs::is_directory(folder))
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
     if (!fs::is_regular_file(csv))
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording folder " + inQuotes(folder) + " holds no frames.csv");
     const std::string where = csv.string();
-    const RecordingIndex index = parseFramesCsv(readText(csv, "recording index"), where);
+    recording::Index index;
+    try {
+        index = recording::parseIndex(readText(csv, "recording index"), where);
+    } catch (const Error &e) {
+        throw Error(e.code(), std::string("replay: ") + e.what());
+    }
 
     Plan plan;
     plan.layout = "recording";
     plan.lenientLastFrame = true;
-    if (!index.droppedLast.empty()) {
-        host.warning("replay: " + index.droppedLast + ": a recording cut short; it is ignored");
+    if (!index.dropped_last.empty()) {
+        host.warning("replay: " + index.dropped_last + ": a recording cut short; it is ignored");
         ++plan.droppedAtEnd;
     }
     std::vector<int> lineOf;
-    for (const RecordedPair &p : index.pairs) {
+    for (const recording::Row &p : index.rows) {
         FrameFiles f;
         f.hasTimestamps = true;
-        f.timestampLeftNs = p.timestampLeftNs;
-        f.timestampRightNs = p.timestampRightNs;
+        f.timestampLeftNs = p.timestamp_left_ns;
+        f.timestampRightNs = p.timestamp_right_ns;
         f.left = folder / p.left;
         f.right = folder / p.right;
         f.facts.emplace_back("recorded_sequence", std::to_string(p.sequence));
@@ -512,7 +518,7 @@ Plan planRecording(const Settings &s, const sdk::Host &host) {
     if (plan.frames.empty())
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording " + inQuotes(folder) + " holds no complete frame");
 
-    const fs::path calibration = folder / "calibration.yml";
+    const fs::path calibration = folder / recording::kCalibrationFile;
     if (fs::is_regular_file(calibration)) plan.calibration = readText(calibration, "calibration");
     else if (s.calibration.empty())
         host.warning("replay: recording " + inQuotes(folder) + " has no calibration.yml; it brings no calibration");
@@ -532,7 +538,7 @@ std::string detectLayout(const Settings &s) {
     if (!fs::is_directory(folder))
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
     KittiCameras cams;
-    if (fs::is_regular_file(folder / "frames.csv")) return "recording";
+    if (fs::is_regular_file(folder / recording::kIndexFile)) return "recording";
     if (isMiddleburyScene(folder)) return "middlebury";
     if (kittiCameras(folder, cams)) return "kitti";
     for (const fs::path &sub : listFolder(folder, true))

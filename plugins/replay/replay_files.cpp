@@ -163,13 +163,11 @@ std::vector<fs::path> listFolder(const fs::path &folder, bool folders) {
 }
 
 cv::Mat readPfm(const fs::path &path) {
-    std::vector<uint8_t> bytes;
     try {
-        bytes = input::readImageFileBytes(path.string(), "PFM file");
+        return input::readPfm(path.string());
     } catch (const input::ImageFileError &e) {
         throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
     }
-    return decodePfm(bytes.data(), bytes.size(), path.string());
 }
 
 GroundTruth readGroundTruth(const fs::path &path, double scale) {

@@ -28,9 +28,9 @@ std::vector<std::filesystem::path> globPaths(const std::string &pattern);
 // The entries of a folder, in natural order; regular files or folders only.
 std::vector<std::filesystem::path> listFolder(const std::filesystem::path &folder, bool folders);
 
-// Portable Float Map: "Pf" (1 channel) or "PF" (3 channels), negative scale =
-// little-endian, rows stored bottom to top. Returns CV_32FC1 or CV_32FC3, top row first,
-// values as stored (inf stays inf). Throws sdk::Error naming the file.
+// Portable Float Map through Binocle's one PFM path (input::readPfm: header checked,
+// then OpenCV's codec): CV_32FC1 or CV_32FC3, top row first, values as stored (inf stays
+// inf). Throws sdk::Error naming the file.
 cv::Mat readPfm(const std::filesystem::path &path);
 
 // A disparity ground truth, decoded by format:

@@ -5,12 +5,18 @@
 
 #include "random.hpp"
 
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+#include "input/yaml_file.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <type_traits>
 
 namespace binocle::sim {
 
@@ -21,29 +27,41 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 } // namespace
 
 BoardSettings BoardSettings::fromYaml(const std::string &text) {
+    const std::string origin = "calibration_board";
     BoardSettings b;
-    YAML::Node n;
     try {
-        n = YAML::Load(text);
-    } catch (const YAML::Exception &e) {
-        throw SceneError("calibration_board: not valid YAML: " + e.msg);
-    }
-    if (!n.IsMap()) throw SceneError("calibration_board: expected a map {cols, rows, square_mm, poses}");
-    for (const auto &kv : n) {
-        const std::string key = kv.first.as<std::string>();
-        try {
-            if (key == "cols") b.cols = kv.second.as<int>();
-            else if (key == "rows") b.rows = kv.second.as<int>();
-            else if (key == "square_mm") b.square_mm = kv.second.as<double>();
-            else if (key == "poses") b.poses = kv.second.as<int>();
-            else if (key == "max_tilt_deg") b.max_tilt_deg = kv.second.as<double>();
-            else if (key == "seed") b.seed = kv.second.as<uint32_t>();
-            else
-                throw SceneError("calibration_board: unknown key '" + key +
-                                 "' (expected cols, rows, square_mm, poses, max_tilt_deg, seed)");
-        } catch (const YAML::Exception &) {
-            throw SceneError("calibration_board." + key + " = '" + kv.second.as<std::string>("?") + "': expected a number");
-        }
+        // The framework's strict readers: duplicate keys, unknown keys and octal-looking
+        // or out-of-range numbers are refused with their position.
+        const YAML::Node n = input::parseYaml(text, origin);
+        input::checkKeys(n, {"cols", "rows", "square_mm", "poses", "max_tilt_deg", "seed"}, origin, origin);
+        auto integer = [&](const char *key, int64_t min, int64_t max, auto &out) {
+            const YAML::Node v = n[key];
+            if (!v) return;
+            int64_t parsed = 0;
+            std::string why;
+            if (!v.IsScalar() || !input::parseInteger(v.Scalar(), parsed, &why, min, max))
+                throw SceneError(input::located(v, origin) + ": " + origin + "." + key + " = '" +
+                                 (v.IsScalar() ? input::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
+                                 (why.empty() ? "expected a decimal integer" : why));
+            out = static_cast<std::remove_reference_t<decltype(out)>>(parsed);
+        };
+        auto real = [&](const char *key, double &out) {
+            const YAML::Node v = n[key];
+            if (!v) return;
+            std::string why;
+            if (!v.IsScalar() || !input::parseReal(v.Scalar(), out, &why))
+                throw SceneError(input::located(v, origin) + ": " + origin + "." + key + " = '" +
+                                 (v.IsScalar() ? input::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
+                                 (why.empty() ? "expected a number" : why));
+        };
+        integer("cols", 2, 1000, b.cols);
+        integer("rows", 2, 1000, b.rows);
+        integer("poses", 0, INT32_MAX, b.poses);
+        integer("seed", 0, UINT32_MAX, b.seed);
+        real("square_mm", b.square_mm);
+        real("max_tilt_deg", b.max_tilt_deg);
+    } catch (const input::YamlError &e) {
+        throw SceneError(e.what());
     }
     if (b.cols < 2 || b.rows < 2) throw SceneError("calibration_board: cols and rows must be >= 2 (inner corners)");
     if (!(b.square_mm > 0)) throw SceneError("calibration_board.square_mm: expected a value > 0");

@@ -40,16 +40,9 @@ public:
     }
 
     // Refuses keys of `map` that are not in `allowed` (a typo must not pass silently).
-    void onlyKeys(const YAML::Node &map, const std::string &what, const std::set<std::string> &allowed) const {
+    void onlyKeys(const YAML::Node &map, const std::string &what, const std::vector<std::string> &allowed) const {
         if (!map.IsMap()) fail(map, what + ": expected a map");
-        for (const auto &kv : map) {
-            const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "(a non-scalar key)";
-            if (!allowed.count(key)) {
-                std::string list;
-                for (const auto &a : allowed) list += (list.empty() ? "" : ", ") + a;
-                fail(kv.first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
-            }
-        }
+        if (auto unknown = binocle::input::findUnknownKey(map, allowed)) fail(unknown->key, what + ": " + unknown->message);
     }
 
     double number(const YAML::Node &map, const std::string &key, double def, const std::string &what) const {

@@ -2,6 +2,7 @@
 // Rig YAML: validation against plugin tables, errors with file:line:col, --set overrides.
 #include "common/test_util.hpp"
 #include "config/rig_config.hpp"
+#include "input/text.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
 
@@ -160,9 +161,9 @@ TEST_F(RigConfigTest, YamlSyntaxErrorHasLineAndColumn) {
 }
 
 TEST(Nearest, FindsCloseNamesOnly) {
-    EXPECT_EQ(nearest("num_disparity", {"num_disparities", "block_size"}), "num_disparities");
-    EXPECT_EQ(nearest("blok_size", {"num_disparities", "block_size"}), "block_size");
-    EXPECT_EQ(nearest("zzz", {"num_disparities", "block_size"}), "");
+    EXPECT_EQ(input::nearestWord("num_disparity", {"num_disparities", "block_size"}), "num_disparities");
+    EXPECT_EQ(input::nearestWord("blok_size", {"num_disparities", "block_size"}), "block_size");
+    EXPECT_EQ(input::nearestWord("zzz", {"num_disparities", "block_size"}), "");
 }
 
 } // namespace

@@ -1,11 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Fuzz harness: the index of a recording (frames.csv), read by the replay source. Every
-// path it accepts must stay inside the recording folder.
-#include "replay_metadata.hpp"
-
-#include "input/text.hpp"
-
-#include <binocle/plugin.hpp>
+// Fuzz harness: the index of a recording (frames.csv), as the SDK's reader
+// (binocle/recording.hpp) reads it for the replay source. Every path it accepts must stay
+// inside the recording folder, and every row it keeps must write back as it was read.
+#include <binocle/recording.hpp>
 
 #include <cstdint>
 #include <cstdlib>
@@ -14,10 +11,11 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     const std::string text(reinterpret_cast<const char *>(data), size);
     try {
-        const auto index = binocle::replay::parseFramesCsv(text, "frames.csv");
-        for (const auto &p : index.pairs)
-            if (!binocle::input::isConfinedRelativePath(p.left) || !binocle::input::isConfinedRelativePath(p.right))
-                std::abort();
+        const auto index = binocle::recording::parseIndex(text, "frames.csv");
+        for (const auto &r : index.rows) {
+            if (!binocle::sdk::isConfinedRelativePath(r.left) || !binocle::sdk::isConfinedRelativePath(r.right)) std::abort();
+            if (r.sequence < 0) std::abort();
+        }
     } catch (const binocle::sdk::Error &) {
     }
     return 0;

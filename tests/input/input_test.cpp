@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <sstream>
 
@@ -152,6 +153,60 @@ TEST(Yaml, DuplicateKeysBadUtf8AndSyntaxSayWhere) {
     bomb << "l0: &l0 [a, b, c, d, e, f, g, h, i]\n";
     for (int i = 1; i < 12; ++i) bomb << "l" << i << ": &l" << i << " [*l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << ", *l" << i - 1 << "]\n";
     EXPECT_EQ(yamlError(bomb.str()), "");
+}
+
+
+
+TEST(Yaml, OneKeyCheckerNamesTheKeyTheNearestAndTheValidOnes) {
+    const YAML::Node n = parseYaml("source: x\nmatchr: y\n", "rig.yaml");
+    const auto unknown = findUnknownKey(n, {"source", "matcher"});
+    ASSERT_TRUE(unknown.has_value());
+    EXPECT_EQ(unknown->name, "matchr");
+    EXPECT_EQ(unknown->message, "unknown key 'matchr'; did you mean 'matcher'? (valid keys: source, matcher)");
+    EXPECT_EQ(located(unknown->key, "rig.yaml"), "rig.yaml:2:1");
+    EXPECT_FALSE(findUnknownKey(n, {"source", "matchr"}).has_value());
+    const auto owned = findUnknownKey(parseYaml("zzz: 1", "x"), {"block_size"}, "for plugin 'bm'");
+    ASSERT_TRUE(owned.has_value());
+    EXPECT_EQ(owned->message, "unknown key 'zzz' for plugin 'bm' (valid keys: block_size)");
+    try {
+        checkKeys(n, {"source"}, "rig", "rig.yaml");
+        FAIL() << "an unknown key passed";
+    } catch (const YamlError &e) {
+        EXPECT_STREQ(e.what(), "rig.yaml:2:1: rig: unknown key 'matchr' (valid keys: source)");
+    }
+    EXPECT_THROW(checkKeys(parseYaml("[1, 2]", "x"), {"a"}, "list", "x"), YamlError);
+    EXPECT_EQ(nearestWord("num_disparity", {"min_disparity", "num_disparities"}), "num_disparities");
+    EXPECT_EQ(nearestWord("zzz", {"num_disparities", "block_size"}), "");
+}
+
+TEST(ImageFile, OnePfmPathRoundTripsThroughOpenCvsCodec) {
+    cv::Mat m(3, 4, CV_32FC1);
+    for (int i = 0; i < 12; ++i) m.at<float>(i) = 1.5f * static_cast<float>(i);
+    m.at<float>(5) = std::numeric_limits<float>::infinity();
+    std::vector<uchar> bytes;
+    ASSERT_TRUE(cv::imencode(".pfm", m, bytes));
+    const cv::Mat back = decodePfm(bytes.data(), bytes.size(), "x.pfm");
+    ASSERT_EQ(back.type(), CV_32FC1);
+    EXPECT_EQ(cv::countNonZero(back != m), 0);
+    // Big-endian data (a positive scale), rows bottom to top: [1 2] on top of [3 4].
+    const unsigned char be[] = {'P', 'f', '\n', '2', ' ', '2', '\n', '1', '.', '0', '\n',
+                                0x40, 0x40, 0, 0, 0x40, 0x80, 0, 0, 0x3f, 0x80, 0, 0, 0x40, 0, 0, 0};
+    const cv::Mat b = decodePfm(be, sizeof be, "be.pfm");
+    EXPECT_EQ(b.at<float>(0, 0), 1.0f);
+    EXPECT_EQ(b.at<float>(1, 1), 4.0f);
+    // Cut short, claiming more than it holds, or not a PFM: refused with the reason.
+    for (size_t cut : {bytes.size() - 1, size_t{8}})
+        EXPECT_THROW(decodePfm(bytes.data(), cut, "cut.pfm"), ImageFileError) << cut;
+    const std::string huge = "Pf\n65536 65536\n-1.0\n";
+    try {
+        decodePfm(reinterpret_cast<const uint8_t *>(huge.data()), huge.size(), "huge.pfm");
+        FAIL() << "a PFM header claiming 65536 x 65536 was decoded";
+    } catch (const ImageFileError &e) {
+        EXPECT_NE(std::string(e.what()).find("huge.pfm"), std::string::npos) << e.what();
+    }
+    std::vector<uchar> png;
+    cv::imencode(".png", cv::Mat(2, 2, CV_8UC1, cv::Scalar(1)), png);
+    EXPECT_THROW(decodePfm(png.data(), png.size(), "x.png"), ImageFileError);
 }
 
 } // namespace

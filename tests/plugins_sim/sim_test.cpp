@@ -123,7 +123,12 @@ TEST(SimPlugin, CalibrationBoardWithoutAPoseCountIsEndless) {
     }
     std::sort(origins.begin(), origins.end());
     EXPECT_EQ(std::unique(origins.begin(), origins.end()), origins.end()) << "every frame a new pose";
-    EXPECT_NE(errorOf([] { makeSim("{calibration_board: {poses: -1}}"); }).find("poses: expected a value >= 0"), std::string::npos);
+    EXPECT_NE(errorOf([] { makeSim("{calibration_board: {poses: -1}}"); }).find("calibration_board.poses = '-1': expected an integer >= 0"),
+              std::string::npos);
+    // The framework's strict readers: an octal-looking number and an unknown key are named.
+    EXPECT_NE(errorOf([] { makeSim("{calibration_board: {cols: 09}}"); }).find("without leading zeros"), std::string::npos);
+    EXPECT_NE(errorOf([] { makeSim("{calibration_board: {colz: 9}}"); }).find("unknown key 'colz'; did you mean 'cols'?"),
+              std::string::npos);
 }
 
 TEST(SimPlugin, PublishesItsExactCalibration) {

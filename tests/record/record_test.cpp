@@ -8,6 +8,7 @@
 #include "host/plugin_host.hpp"
 #include "pipeline/recorder.hpp"
 
+#include <binocle/recording.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -347,7 +348,7 @@ TEST(RecordingWriter, AFullQueueRefusesWithoutWaitingAndRowsKeepTheirOrder) {
     for (uint64_t sequence : accepted) {
         ASSERT_TRUE(std::getline(csv, line));
         EXPECT_EQ(line.substr(0, line.find(',')), std::to_string(sequence));
-        EXPECT_TRUE(fs::exists(dir.str("rec/" + binocle::RecordingWriter::imagePath("right", sequence))));
+        EXPECT_TRUE(fs::exists(dir.str("rec/" + binocle::recording::imagePath(1, sequence))));
     }
     EXPECT_FALSE(std::getline(csv, line)) << "a row for a frame that was refused";
 }

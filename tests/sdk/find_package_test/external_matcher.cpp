@@ -2,6 +2,9 @@
 // external_matcher: a plugin built outside the Binocle tree with the installed SDK only;
 // writes disparity_px wherever the left pixel is not black.
 #include <binocle/plugin.hpp>
+// The header-only helpers compile from the installed SDK alone, too.
+#include <binocle/recording.hpp>
+#include <binocle/text.hpp>
 
 #include <cstdint>
 
