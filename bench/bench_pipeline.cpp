@@ -5,7 +5,8 @@
 //   block 5) -> reprojectImageTo3D -> drop invalid points, R1^T, Eq. 1 -> three density grids
 // and the pipeline with replay (loop) | bm or sgbm | ground | density_grids, no outputs.
 //   build/bench/binocle_bench --benchmark_filter=PipelineVersusSerial
-// A replay soak at 320 x 240 reports the resident memory after 1 000 frames and at the end
+// A replay soak at 320 x 240 reports the resident memory after 1 000 frames and at the last
+// frame (both while the pipeline runs; rss_growth_after_1000_MiB is their difference)
 // (BINOCLE_SOAK_FRAMES, default 100 000; minutes):
 //   build/bench/binocle_bench --benchmark_filter=ReplaySoak
 #include "config/rig_config.hpp"

@@ -208,15 +208,12 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
 const std::vector<std::string> kBlockKeys = {"plugin", "isolation", "call_timeout_ms", "restart", "max_restarts"};
 
 // `isolation: process|none`, `call_timeout_ms`, `restart`, `max_restarts` of a block.
-IsolationOptions isolationOf(const YAML::Node &node, const std::string &where, int32_t kind, const Context &ctx) {
+IsolationOptions isolationOf(const YAML::Node &node, const std::string &where, const Context &ctx) {
     IsolationOptions o;
     if (YAML::Node n = node["isolation"]) {
         if (!n.IsScalar() || (n.Scalar() != "process" && n.Scalar() != "none"))
             ctx.fail(n, where + ".isolation", "value '" + scalarText(n) + "' is not valid: expected process or none");
         o.process = n.Scalar() == "process";
-        if (o.process && kind != BINOCLE_KIND_MATCHER)
-            ctx.fail(n, where + ".isolation", std::string("isolation: process is supported for matchers only, not for a ") +
-                                                 kindName(kind) + " (yet)");
     }
     auto integer = [&](const char *key, int32_t &v, int32_t least) {
         YAML::Node n = node[key];
@@ -347,8 +344,10 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
     b.plugin = p.Scalar();
     b.location = ctx.at(node, where);
     // Opens binocle_<name>.so only; the whole search path is examined (in children) only
-    // to say what else there is.
-    b.record = host.lookup(b.plugin, kind);
+    // to say what else there is. An isolated plugin is read by a helper process: none of
+    // its code runs in this one, not even its library's constructors.
+    const IsolationOptions isolation = isolationOf(node, where, ctx);
+    b.record = isolation.process ? host.describe(b.plugin, kind) : host.lookup(b.plugin, kind);
     if (!b.record) {
         host.scan(ScanMode::Isolated);
         std::vector<std::string> names;
@@ -364,7 +363,7 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
                                            " (available: " + (all.empty() ? "none" : all) + ")" + refused);
     }
     b.params = resolveWith(*b.record, node, where, ctx);
-    b.params.setIsolation(isolationOf(node, where, kind, ctx));
+    b.params.setIsolation(isolation);
     return b;
 }
 

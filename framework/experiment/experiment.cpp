@@ -114,7 +114,9 @@ struct Reader {
 // is missing (the rig's own validation says so, with its position).
 std::vector<binocle_param_desc> settingsOf(const YAML::Node &block, int32_t kind, const PluginHost &host) {
     if (!block.IsMap() || !block["plugin"] || !block["plugin"].IsScalar()) return {};
-    const PluginRecord *p = host.lookup(block["plugin"].Scalar(), kind);
+    const YAML::Node isolation = block["isolation"];
+    const bool isolated = isolation && isolation.IsScalar() && isolation.Scalar() == "process";
+    const PluginRecord *p = isolated ? host.describe(block["plugin"].Scalar(), kind) : host.lookup(block["plugin"].Scalar(), kind);
     return p ? p->params() : std::vector<binocle_param_desc>{};
 }
 
@@ -726,9 +728,12 @@ OJson software(const PluginHost &host, const YAML::Node &rig) {
         if (rig[key] && rig[key].IsSequence())
             for (const auto &b : rig[key]) add(b);
     OJson plugins = OJson::array();
-    for (const auto &name : named) // sorted by name
-        for (const auto &p : host.plugins())
-            if (p.name == name) plugins.push_back({{"name", p.name}, {"version", p.version}, {"kind", kindName(p.kind)}});
+    for (const auto &name : named) { // sorted by name
+        const PluginRecord *p = host.find(name);
+        for (const auto &d : host.described()) // an isolated plugin is described, not opened
+            if (!p && d.name == name) p = &d;
+        if (p) plugins.push_back({{"name", p->name}, {"version", p->version}, {"kind", kindName(p->kind)}});
+    }
     return {{"binocle", BINOCLE_VERSION}, {"opencv", CV_VERSION}, {"plugins", std::move(plugins)}};
 }
 

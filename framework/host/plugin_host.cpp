@@ -31,6 +31,17 @@ const char *kindName(int32_t kind) {
     }
 }
 
+int bytesPerPixel(int32_t format) {
+    switch (format) {
+    case BINOCLE_PIXEL_GRAY8: return 1;
+    case BINOCLE_PIXEL_GRAY16: return 2;
+    case BINOCLE_PIXEL_BGR8:
+    case BINOCLE_PIXEL_RGB8: return 3;
+    case BINOCLE_PIXEL_FLOAT32: return 4;
+    default: return 0;
+    }
+}
+
 const char *resultName(int32_t code) {
     switch (code) {
     case BINOCLE_OK: return "BINOCLE_OK";
@@ -415,6 +426,25 @@ const PluginRecord *PluginHost::lookup(const std::string &name, int32_t kind) co
     }
 }
 
+const PluginRecord *PluginHost::describe(const std::string &name, int32_t kind, int32_t timeout_ms) const {
+    const std::string path = locate(name);
+    if (path.empty()) return nullptr;
+    for (const auto &r : described_)
+        if (r.path == path) return kind == 0 || r.kind == kind ? &r : nullptr;
+    for (const auto &r : refused_)
+        if (r.path == path) return nullptr;
+    try {
+        if (std::string why = unsafeReason(path, false); !why.empty()) throw Error(why);
+        PluginRecord r = describeInHelper(path, timeout_ms);
+        described_.push_back(std::move(r));
+        const PluginRecord &d = described_.back();
+        return kind == 0 || d.kind == kind ? &d : nullptr;
+    } catch (const Error &e) {
+        refused_.push_back({path, e.what()});
+        return nullptr;
+    }
+}
+
 const PluginRecord &PluginHost::inspect(const std::string &path) const {
     if (std::string why = unsafeReason(path, false); !why.empty()) throw Error(why);
     auto lib = std::make_shared<boost::dll::shared_library>();
@@ -632,6 +662,13 @@ PluginInstanceBase::PluginInstanceBase(const PluginRecord &record) : record_(rec
 
 void PluginInstanceBase::setSink(HostSink sink) { reinterpret_cast<HostBlock *>(host_.get())->ctx.sink = std::move(sink); }
 
+int32_t PluginInstanceBase::restarts() const { return helper_ ? helper_->restarts() : 0; }
+int64_t PluginInstanceBase::lostCalls() const { return helper_ ? helper_->lostCalls() : 0; }
+
+bool PluginInstanceBase::runsIsolated(const PluginRecord &record, const ParamValues &params) {
+    return params.isolation().process || record.described;
+}
+
 void PluginInstanceBase::fail(const std::string &what, int32_t code, const char *message) const {
     std::string msg = std::string(kindName(record_.kind)) + " plugin '" + record_.name + "' (" + record_.path + "): " + what +
                       " failed (" + resultName(code) + ")";
@@ -644,16 +681,7 @@ namespace {
 // Checks an image a plugin handed back; returns "" when fine, else what is wrong.
 std::string checkImage(const binocle_image &im, const char *what) {
     std::ostringstream os;
-    const int bpp = [&] {
-        switch (im.format) {
-        case BINOCLE_PIXEL_GRAY8: return 1;
-        case BINOCLE_PIXEL_GRAY16: return 2;
-        case BINOCLE_PIXEL_BGR8:
-        case BINOCLE_PIXEL_RGB8: return 3;
-        case BINOCLE_PIXEL_FLOAT32: return 4;
-        default: return 0;
-        }
-    }();
+    const int bpp = bytesPerPixel(im.format);
     if (bpp == 0) os << what << " has unknown pixel format " << im.format;
     else if (im.width <= 0 || im.height <= 0 || im.width > 65536 || im.height > 65536)
         os << what << " has an impossible size " << im.width << "x" << im.height;
@@ -707,7 +735,11 @@ LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_source_api *api, 
                      const binocle_stereo_frame &f)
     : keep_(std::move(keep)), api_(api), src_(src), frame_(f) {}
 
+LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_stereo_frame &f)
+    : keep_(std::move(keep)), api_(nullptr), src_(nullptr), frame_(f) {}
+
 LentFrame::~LentFrame() {
+    if (!api_) return; // keep_ holds the copy; dropping it is the release
     try {
         const int32_t rc = api_->release_frame(src_, frame_.frame_id);
         if (rc != BINOCLE_OK) {
@@ -733,6 +765,12 @@ cv::Mat LentFrame::extra(const std::string &name) const {
 
 Source::Source(const PluginRecord &record, const ParamValues &params)
     : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_source_api *>(record.table)) {
+    if (runsIsolated(record, params)) {
+        // create and every later call run in the helper process only.
+        isolated_ = std::make_unique<SourceHelper>(record, params, host_.get());
+        helper_ = isolated_.get();
+        return;
+    }
     binocle_source *h = nullptr;
     int32_t rc = api_->create(params.data(), params.size(), host_.get(), &h);
     if (rc != BINOCLE_OK || !h) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
@@ -759,18 +797,21 @@ Source::~Source() {
 }
 
 void Source::start() {
+    if (isolated_) return isolated_->start();
     if (!api_->start) return;
     int32_t rc = api_->start(handle_.get());
     if (rc != BINOCLE_OK) fail("start", rc, api_->last_error(handle_.get()));
 }
 
 void Source::stop() {
+    if (isolated_) return isolated_->stop();
     if (!api_->stop) return;
     int32_t rc = api_->stop(handle_.get());
     if (rc != BINOCLE_OK) fail("stop", rc, api_->last_error(handle_.get()));
 }
 
 std::unique_ptr<LentFrame> Source::grab(int32_t timeout_ms) {
+    if (isolated_) return isolated_->grab(timeout_ms);
     binocle_stereo_frame f{};
     f.struct_size = sizeof(f);
     int32_t rc = api_->grab(handle_.get(), timeout_ms, &f);
@@ -797,6 +838,7 @@ std::unique_ptr<LentFrame> Source::grab(int32_t timeout_ms) {
 }
 
 std::string Source::calibration() {
+    if (isolated_) return isolated_->calibration();
     if (!api_->calibration) return {};
     const char *yaml = nullptr;
     int32_t rc = api_->calibration(handle_.get(), &yaml);
@@ -805,6 +847,7 @@ std::string Source::calibration() {
 }
 
 std::string Source::statistics() {
+    if (isolated_) return isolated_->statistics();
     if (!api_->statistics) return {};
     const char *yaml = nullptr;
     int32_t rc = api_->statistics(handle_.get(), &yaml);
@@ -837,9 +880,10 @@ std::string Source::enumerateDevices(const PluginRecord &record) {
 
 Matcher::Matcher(const PluginRecord &record, const ParamValues &params)
     : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_matcher_api *>(record.table)) {
-    if (params.isolation().process) {
+    if (runsIsolated(record, params)) {
         // The plugin's create and every later call run in the helper process only.
-        helper_ = std::make_unique<MatcherHelper>(record, params);
+        isolated_ = std::make_unique<MatcherHelper>(record, params, host_.get());
+        helper_ = isolated_.get();
         return;
     }
     int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
@@ -861,7 +905,7 @@ void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispar
         throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
     disparity.create(left.size(), CV_32F);
     disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
-    if (helper_) helper_->compute(left, right, disparity);
+    if (isolated_) isolated_->compute(left, right, disparity);
     else computeInto(left, right, disparity);
     // A disparity is at most the image width; inf, NaN or 1e30 would become cloud points.
     const float limit = static_cast<float>(disparity.cols);
@@ -898,7 +942,7 @@ void Matcher::computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &di
 }
 
 std::pair<int32_t, int32_t> Matcher::disparityRange() {
-    if (helper_) return helper_->disparityRange();
+    if (isolated_) return isolated_->disparityRange();
     int32_t mn = 0, num = 0;
     if (!api_->disparity_range) return {0, 0};
     int32_t rc = api_->disparity_range(handle_, &mn, &num);
@@ -910,6 +954,11 @@ std::pair<int32_t, int32_t> Matcher::disparityRange() {
 
 CloudTransform::CloudTransform(const PluginRecord &record, const ParamValues &params)
     : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_cloud_transform_api *>(record.table)) {
+    if (runsIsolated(record, params)) {
+        isolated_ = std::make_unique<TransformHelper>(record, params, host_.get());
+        helper_ = isolated_.get();
+        return;
+    }
     int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
     if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
 }
@@ -919,6 +968,7 @@ CloudTransform::~CloudTransform() {
 }
 
 void CloudTransform::apply(binocle_cloud &cloud) {
+    if (isolated_) return isolated_->apply(cloud); // the helper's wrapper checked the cloud
     const binocle_cloud before = cloud;
     int32_t rc = api_->apply(handle_, &cloud);
     if (rc != BINOCLE_OK) fail("apply", rc, api_->last_error(handle_));
@@ -938,6 +988,11 @@ void CloudTransform::apply(binocle_cloud &cloud) {
 Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink)
     : PluginInstanceBase(record), api_(reinterpret_cast<const binocle_evaluator_api *>(record.table)) {
     setSink(std::move(sink));
+    if (runsIsolated(record, params)) {
+        isolated_ = std::make_unique<EvaluatorHelper>(record, params, host_.get());
+        helper_ = isolated_.get();
+        return;
+    }
     int32_t rc = api_->create(params.data(), params.size(), host_.get(), &handle_);
     if (rc != BINOCLE_OK || !handle_) fail("create", rc ? rc : BINOCLE_ERR_INTERNAL, api_->last_error(nullptr));
 }
@@ -947,11 +1002,13 @@ Evaluator::~Evaluator() {
 }
 
 void Evaluator::evaluate(const binocle_eval_input &input) {
+    if (isolated_) return isolated_->evaluate(input);
     int32_t rc = api_->evaluate(handle_, &input);
     if (rc != BINOCLE_OK) fail("evaluate", rc, api_->last_error(handle_));
 }
 
 void Evaluator::finish() {
+    if (isolated_) return isolated_->finish();
     if (!api_->finish) return;
     int32_t rc = api_->finish(handle_);
     if (rc != BINOCLE_OK) fail("finish", rc, api_->last_error(handle_));

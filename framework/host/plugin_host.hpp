@@ -2,7 +2,7 @@
 // The plugin host: finds plugin files (binocle_<name>.so) on a safe search path, loads
 // them with Boost.DLL (RTLD_NOW), checks their ABI and settings tables before calling
 // anything else, and wraps their C tables in C++ objects that throw
-// binocle::PluginError with the plugin's own message when a call fails. A matcher may
+// binocle::PluginError with the plugin's own message when a call fails. Any plugin may
 // run in a helper process instead (IsolationOptions, host/isolation.hpp).
 #pragma once
 
@@ -26,6 +26,7 @@ namespace binocle {
 
 const char *kindName(int32_t kind);    // "source", "matcher", "transform", "evaluator"
 const char *resultName(int32_t code);  // "BINOCLE_ERR_TIMEOUT" ...
+int bytesPerPixel(int32_t format);     // of a BINOCLE_PIXEL_* format; 0 when unknown
 
 // A plugin file that was accepted.
 struct PluginRecord {
@@ -39,6 +40,9 @@ struct PluginRecord {
     const binocle_plugin_header *table = nullptr;
     std::shared_ptr<const void> tableStorage;
     std::shared_ptr<boost::dll::shared_library> library; // keeps the code loaded
+    // Read by a helper process (PluginHost::describe): header and settings table only, no
+    // library and no entry points here; instances of it run in helper processes only.
+    bool described = false;
     std::vector<binocle_param_desc> params() const;
 };
 
@@ -58,7 +62,7 @@ struct Refusal {
 
 // How a rig runs a plugin: in the process (default), or in a helper process of its own
 // (`isolation: process` in the rig block) that may crash or hang without taking Binocle
-// down. Only matchers honour `process` for now.
+// down; every kind of plugin honours it.
 struct IsolationOptions {
     bool process = false;
     int32_t call_timeout_ms = 0; // 0: no watchdog
@@ -95,6 +99,8 @@ struct HostSink {
 };
 
 // Common part of the instance wrappers.
+class PluginHelper;
+
 class PluginInstanceBase {
 public:
     // One wrapper per plugin instance: a copy would destroy the instance twice.
@@ -103,13 +109,21 @@ public:
     const PluginRecord &record() const { return record_; }
     // Replaces where this instance's metrics and logs go (default: log to stderr).
     void setSink(HostSink sink);
+    // True when the plugin runs in a helper process (`isolation: process`).
+    bool isolated() const { return helper_ != nullptr; }
+    // Restarts of its helper process, and calls whose result they lost (0 in process).
+    int32_t restarts() const;
+    int64_t lostCalls() const;
 
 protected:
     explicit PluginInstanceBase(const PluginRecord &record);
     // Throws PluginError "<kind> plugin '<name>' (<path>): <what> failed (<code>): <message>".
     [[noreturn]] void fail(const std::string &what, int32_t code, const char *message) const;
+    // Instances of a described record run isolated whatever the rig says.
+    static bool runsIsolated(const PluginRecord &record, const ParamValues &params);
     PluginRecord record_;
     std::shared_ptr<binocle_host> host_; // deleted with its sink context
+    PluginHelper *helper_ = nullptr;     // the derived class's helper, when isolated
 };
 
 // A frame lent by a source; released when this object dies. Views are zero-copy.
@@ -117,6 +131,9 @@ class LentFrame {
 public:
     LentFrame(std::shared_ptr<void> keep, const binocle_source_api *api, binocle_source *src,
               const binocle_stereo_frame &f);
+    // A frame whose pixels `keep` holds (the copy of an isolated source's frame): nothing
+    // to give back but `keep`.
+    LentFrame(std::shared_ptr<void> keep, const binocle_stereo_frame &f);
     ~LentFrame();
     LentFrame(const LentFrame &) = delete;
     LentFrame &operator=(const LentFrame &) = delete;
@@ -134,6 +151,11 @@ private:
     binocle_stereo_frame frame_;
 };
 
+class SourceHelper;
+class MatcherHelper;
+class TransformHelper;
+class EvaluatorHelper;
+
 class Source : public PluginInstanceBase {
 public:
     Source(const PluginRecord &record, const ParamValues &params);
@@ -149,9 +171,8 @@ public:
 private:
     const binocle_source_api *api_;
     std::shared_ptr<binocle_source> handle_;
+    std::unique_ptr<SourceHelper> isolated_;
 };
-
-class MatcherHelper;
 
 class Matcher : public PluginInstanceBase {
 public:
@@ -169,12 +190,11 @@ public:
     void computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity);
     // Disparities made invalid so far because they were not finite or absurd.
     uint64_t invalidatedDisparities() const { return invalidated_; }
-    bool isolated() const { return helper_ != nullptr; }
 
 private:
     const binocle_matcher_api *api_;
     binocle_matcher *handle_ = nullptr;
-    std::unique_ptr<MatcherHelper> helper_;
+    std::unique_ptr<MatcherHelper> isolated_;
     uint64_t invalidated_ = 0;
     bool warnedInvalid_ = false;
 };
@@ -188,6 +208,7 @@ public:
 private:
     const binocle_cloud_transform_api *api_;
     binocle_cloud_transform *handle_ = nullptr;
+    std::unique_ptr<TransformHelper> isolated_;
 };
 
 class Evaluator : public PluginInstanceBase {
@@ -200,6 +221,7 @@ public:
 private:
     const binocle_evaluator_api *api_;
     binocle_evaluator *handle_ = nullptr;
+    std::unique_ptr<EvaluatorHelper> isolated_;
 };
 
 enum class ScanMode {
@@ -238,10 +260,18 @@ public:
     std::string locate(const std::string &name) const;
     // Throws Error "no <kind> plugin named 'x' (found: a, b, c)"; opens the file like lookup.
     const PluginRecord &require(const std::string &name, int32_t kind) const;
+    // Like lookup for a plugin that runs isolated: binocle_<name>.so is read by a helper
+    // process (describeInHelper, at most timeout_ms), never opened here, so none of its
+    // code runs in this process. A refusal (the signal of a crash, a timeout) lands in
+    // refused(). The record is described (no library).
+    const PluginRecord *describe(const std::string &name, int32_t kind = 0, int32_t timeout_ms = 15000) const;
+    // The records describe() made.
+    const std::deque<PluginRecord> &described() const { return described_; }
 
 private:
     std::vector<std::string> searchPath_;
     mutable std::deque<PluginRecord> plugins_;
+    mutable std::deque<PluginRecord> described_;
     mutable std::vector<Refusal> refused_;
     const PluginRecord &inspect(const std::string &path) const; // throws with reason
     // Folders of the search path that are safe to load from; unsafe ones are refused once.

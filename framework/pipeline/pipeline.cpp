@@ -723,6 +723,22 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     summary["dropped"] = dropped;
     if (s.sourceErrors > 0 || rt.on_source_error == RuntimeOptions::OnSourceError::Retry)
         summary["source_errors"] = {{"outages", s.sourceErrors}, {"recovered", s.recoveries}, {"last", s.lastSourceError}};
+    // Plugins in helper processes (`isolation: process`): restarts, and the calls whose
+    // result they cost (a source's grabs, frames without disparity, dropped clouds, frames
+    // without an evaluator's figures).
+    Json isolation = Json::object();
+    auto isolated = [&](const std::string &where, const PluginInstanceBase &p) {
+        if (!p.isolated()) return;
+        Json &e = isolation[where];
+        e["plugin"] = p.record().name;
+        e["restarts"] = e.value("restarts", 0) + p.restarts();
+        e["lost_calls"] = e.value("lost_calls", int64_t{0}) + p.lostCalls();
+    };
+    isolated("source", *source_);
+    for (const auto &m : matchers_) isolated("matcher", *m);
+    for (size_t i = 0; i < transforms_.size(); ++i) isolated("transforms[" + std::to_string(i) + "]", *transforms_[i]);
+    for (size_t i = 0; i < evaluators_.size(); ++i) isolated("evaluators[" + std::to_string(i) + "]", *evaluators_[i]->evaluator);
+    if (!isolation.empty()) summary["isolation"] = isolation;
     if (calibrationReady_) {
         summary["calibration"] = {{"baseline_mm", calibration_.baselineMm()},
                                   {"focal_length_px", calibration_.focalLengthPx()},

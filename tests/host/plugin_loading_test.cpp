@@ -19,6 +19,8 @@ TEST(PluginLoading, AcceptsTheWorkingFixturesWithTheirKinds) {
         {"throws_source", BINOCLE_KIND_STEREO_SOURCE}, {"garbage_source", BINOCLE_KIND_STEREO_SOURCE},
         {"garbage_matcher", BINOCLE_KIND_MATCHER},     {"garbage_transform", BINOCLE_KIND_CLOUD_TRANSFORM},
         {"faulty_matcher", BINOCLE_KIND_MATCHER},      {"frozen_matcher", BINOCLE_KIND_MATCHER},
+        {"faulty_source", BINOCLE_KIND_STEREO_SOURCE}, {"faulty_transform", BINOCLE_KIND_CLOUD_TRANSFORM},
+        {"faulty_evaluator", BINOCLE_KIND_EVALUATOR},
         {"overrun_matcher", BINOCLE_KIND_MATCHER},
         {"frozen_source", BINOCLE_KIND_STEREO_SOURCE}, {"future_matcher", BINOCLE_KIND_MATCHER}};
     for (const auto &[name, kind] : expected) {
