@@ -915,7 +915,9 @@ std::vector<std::pair<std::string, double>> runRepeat(const Experiment &e, const
     pipeline.run(run, [&](const FrameResult &fr) {
         ++frames;
         valid += fr.valid_pixel_ratio;
-        for (const auto &[name, value] : fr.figures) {
+        for (const auto &figure : fr.figures) {
+            const std::string &name = figure.first; // a structured binding cannot be captured in C++17 (clang)
+            const double value = figure.second;
             auto it = std::find_if(sums.begin(), sums.end(), [&](const auto &p) { return p.first == name; });
             if (it == sums.end()) {
                 sums.emplace_back(name, 0.0);
