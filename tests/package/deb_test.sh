@@ -24,9 +24,11 @@ bin="$work/root/usr/bin/binocle"
 fail() { echo "FAIL: $*"; exit 1; }
 [ -x "$bin" ] || fail "no usr/bin/binocle in the package"
 plugins=$("$bin" plugins --verbose)
-echo "$plugins" | head -n 40
+# Here-strings, not pipes: under pipefail, a reader that stops early (head, grep -q)
+# would make the writer's SIGPIPE fail the test.
+head -n 40 <<<"$plugins"
 for p in sim replay sgbm bm ground paper disparity; do
-  echo "$plugins" | grep -q "file: $work/root/usr/lib/binocle/plugins/binocle_$p.so" || fail "plugin $p not loaded from the package"
+  grep -qF "file: $work/root/usr/lib/binocle/plugins/binocle_$p.so" <<<"$plugins" || fail "plugin $p not loaded from the package"
 done
 "$bin" run "$work/root/usr/share/binocle/configs/rigs/opencv-aloe.yaml" --quiet --frames 1 --out "$work/out"
 grep -q '"status": "ok"' "$work/out/summary.json" || fail "the rig did not run from the package"
