@@ -4,8 +4,8 @@
 # Sanitizer (-DBINOCLE_SANITIZE=address,undefined, float-cast-overflow included) and the
 # libFuzzer harnesses (-DBINOCLE_FUZZ=ON), in ./build-sanitize (or
 # $BINOCLE_SANITIZE_BUILD_DIR). Builds only what it runs:
-#   1. the tests labelled "sanitize" (host, config, replay, recorder, pipeline and the
-#      bad-input corpus) under ASan + UBSan, halting on the first finding;
+#   1. the test executables labelled "sanitize" (host, config, replay, recorder, pipeline
+#      and the bad-input corpus) under ASan + UBSan, halting on the first finding;
 #   2. each fuzz harness for $BINOCLE_FUZZ_SECONDS seconds (default 20) from its seed
 #      corpus in tests/fuzz/corpus/.
 # A finding fails the step. BINOCLE_SKIP_FUZZ=1 skips 2.
@@ -39,7 +39,17 @@ built=$(date +%s)
 # keep allocations for the life of the process by design.
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-ctest --test-dir "$dir" -L sanitize --output-on-failure -j "$jobs" --timeout 600
+# The labelled executables themselves, each running all its tests (gtest_discover_tests
+# keeps only a test's first label, so `ctest -L sanitize` would find none of them).
+export BINOCLE_PLUGIN_PATH="$PWD/$dir/lib/binocle/plugins"
+failed=0
+for t in "${targets[@]}"; do
+  exe=$(find "$dir/tests" -type f -name "$t" -perm -u+x | head -n 1)
+  [ -n "$exe" ] || { echo "sanitize: no executable for $t" >&2; failed=1; continue; }
+  echo "== $t (ASan + UBSan)"
+  (cd "$(dirname "$exe")" && timeout 900 "./$t" --gtest_brief=1) || { echo "sanitize: $t FAILED" >&2; failed=1; }
+done
+[ "$failed" = 0 ] || exit 1
 tested=$(date +%s)
 if [ "${BINOCLE_SKIP_FUZZ:-0}" != 1 ]; then
   ctest --test-dir "$dir" -L fuzz --output-on-failure -j "$jobs" --timeout 600
