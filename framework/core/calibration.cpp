@@ -145,6 +145,10 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
         fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     } catch (const cv::Exception &e) {
         throw Error(origin + ": not an OpenCV FileStorage YAML calibration: " + e.err);
+    } catch (const std::exception &e) {
+        // OpenCV's parser lets some std:: errors through (found by fuzzing: a length_error
+        // from a mangled scalar); they are bad input all the same.
+        throw Error(origin + ": not an OpenCV FileStorage YAML calibration: the parser failed (" + e.what() + ")");
     }
     if (!fs.isOpened()) throw Error(origin + ": not an OpenCV FileStorage YAML calibration (expected '%YAML:1.0' and keys M1, D1, ...)");
     StereoCalibration c;

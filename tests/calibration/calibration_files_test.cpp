@@ -2,6 +2,11 @@
 // What `binocle calibrate` writes: configuration names, ROS camera_info YAML, the set of files.
 #include "calibration/calibration_files.hpp"
 #include "common/test_util.hpp"
+#include "core/calibration.hpp"
+#include "core/error.hpp"
+
+#include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -10,6 +15,23 @@ using namespace binocle;
 using binocle::test::TempDir;
 
 namespace {
+
+// Found by the calibration fuzz harness: OpenCV's FileStorage parser threw
+// std::length_error on this mangled file, past the reader's catch (a crash in the harness,
+// a cryptic "basic_string::_M_create" at the CLI). Now a clear binocle::Error naming it.
+TEST(CalibrationReader, ParserFailuresOfOpenCvAreBadInputNamingTheFile) {
+    const std::string path = std::string(BINOCLE_SOURCE_DIR) + "/tests/data/bad_calibration/fuzz-length-error.yml";
+    std::ostringstream text;
+    text << std::ifstream(path, std::ios::binary).rdbuf();
+    ASSERT_FALSE(text.str().empty()) << path;
+    try {
+        StereoCalibration::fromYaml(text.str(), "fuzz-length-error.yml");
+        FAIL() << "the mangled calibration was accepted";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find("fuzz-length-error.yml: not an OpenCV FileStorage YAML calibration"), std::string::npos)
+            << e.what();
+    }
+}
 
 TEST(CalibrationFiles, ConfigurationNames) {
     EXPECT_EQ(configurationName(150.3, 8.0, 384.6), "B150_f8");
