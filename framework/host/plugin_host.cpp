@@ -31,17 +31,6 @@ const char *kindName(int32_t kind) {
     }
 }
 
-int bytesPerPixel(int32_t format) {
-    switch (format) {
-    case BINOCLE_PIXEL_GRAY8: return 1;
-    case BINOCLE_PIXEL_GRAY16: return 2;
-    case BINOCLE_PIXEL_BGR8:
-    case BINOCLE_PIXEL_RGB8: return 3;
-    case BINOCLE_PIXEL_FLOAT32: return 4;
-    default: return 0;
-    }
-}
-
 const char *resultName(int32_t code) {
     switch (code) {
     case BINOCLE_OK: return "BINOCLE_OK";

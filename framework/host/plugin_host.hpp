@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 
 #include <binocle/abi.h>
+#include <binocle/plugin.hpp>
 
 #include <deque>
 #include <functional>
@@ -26,7 +27,7 @@ namespace binocle {
 
 const char *kindName(int32_t kind);    // "source", "matcher", "transform", "evaluator"
 const char *resultName(int32_t code);  // "BINOCLE_ERR_TIMEOUT" ...
-int bytesPerPixel(int32_t format);     // of a BINOCLE_PIXEL_* format; 0 when unknown
+using sdk::bytesPerPixel; // of a BINOCLE_PIXEL_* format, 0 when unknown: the SDK's (binocle/plugin.hpp)
 
 // A plugin file that was accepted.
 struct PluginRecord {
