@@ -94,19 +94,18 @@ try:
     wait_for(lambda: int(driver.find_element("id", "frame-counter").text) > first + 2, 30, "the frame counter to advance")
     check(True, f"the frame counter advances (from {first})")
 
-    # The disparity image's pixels, summed in the page (the image is a blob URL per frame).
+    # The disparity image's pixels, summed in the page (each panel is a canvas the page
+    # draws the frame's decoded image on).
     checksum_js = """
         const done = arguments[arguments.length - 1];
-        const img = document.getElementById('img-disparity');
+        const c = document.getElementById('img-disparity');
         const run = () => {
-          const c = document.createElement('canvas');
-          c.width = img.naturalWidth; c.height = img.naturalHeight;
-          const g = c.getContext('2d'); g.drawImage(img, 0, 0);
-          const d = g.getImageData(0, 0, c.width, c.height).data;
+          const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
           let h = 0; for (let i = 0; i < d.length; i++) h = (h * 31 + d[i]) >>> 0;
-          done([Number(img.dataset.sequence), h, c.width, c.height]);
+          done([Number(c.dataset.sequence), h, c.width, c.height]);
         };
-        if (img.complete && img.naturalWidth) run(); else img.onload = run;
+        const wait = () => (c.dataset.sequence ? run() : setTimeout(wait, 50));
+        wait();
     """
     seq_a, sum_a, w, h = driver.execute_async_script(checksum_js)
     wait_for(lambda: int(driver.find_element("id", "sequence").text) > seq_a, 30, "another frame")
@@ -115,9 +114,9 @@ try:
     check(seq_b != seq_a and sum_b != sum_a, f"the disparity image changes between frames {seq_a} and {seq_b}")
 
     for name in ("left", "right", "top", "front", "side"):
-        # A new frame's image may be loading at the moment asked: wait for one loaded.
-        size = wait_for(lambda: (lambda s: s if s[0] > 0 else None)(driver.execute_script(
-            f"const i = document.getElementById('img-{name}'); return [i.naturalWidth, i.naturalHeight];")),
+        # Drawn once a frame's image is decoded: the canvas then has its size and a sequence.
+        size = wait_for(lambda: (lambda s: s if s[2] else None)(driver.execute_script(
+            f"const c = document.getElementById('img-{name}'); return [c.width, c.height, c.dataset.sequence || ''];")),
             10, f"panel {name}'s image")
         check(size[0] > 0 and size[1] > 0, f"panel {name} shows an image ({size[0]} x {size[1]})")
     cloud_note = driver.find_element("id", "cloud-note").text

@@ -6,7 +6,7 @@
 const token = new URLSearchParams(location.search).get('token') || '';
 const $ = (id) => document.getElementById(id);
 // Read by the browser tests: what the page has received.
-// showMs: from a frame's arrival until its images were decoded, summed over the frames
+// showMs: from a frame's arrival until it was drawn, summed over the frames
 // received (bench/view_overhead.py reads it).
 window.binocle = { framesReceived: 0, lastHeader: null, lastError: '', state: null, replies: [], showMs: 0 };
 
@@ -15,7 +15,6 @@ let colorScale = [];
 let controlsSignature = '';
 let figuresSignature = '';
 let scaleSignature = '';
-const objectUrls = {};
 
 function showMessage(text, info) {
   const m = $('message');
@@ -190,16 +189,36 @@ function markControl(key, message) {
 }
 
 // ---- Frames -----------------------------------------------------------------------
-// Told to the server once a frame's images are decoded: it sends the next frame only then,
-// so this page never gets more frames than it can show (server.hpp). Not after a
-// requestAnimationFrame: a headless or busy browser may hold those back for seconds.
-function shown(images, arrived) {
-  Promise.allSettled(images.map((img) => img.decode())).then(() => {
-    window.binocle.showMs += performance.now() - arrived;
-    send({ op: 'shown' });
-  });
+const imageNames = ['left', 'right', 'disparity', 'top', 'front', 'side'];
+
+// One image's bytes to something a canvas can draw, decoded off the page's thread.
+// ImageDecoder (WebCodecs) reads the frame's own buffer: no Blob, no object URL, no
+// round trip through the browser process (those cost more CPU than the decoding, measured
+// by bench/view_overhead.py). Where it is missing (a non-local origin, another browser),
+// createImageBitmap of a Blob.
+function decodeImage(bytes, type) {
+  if (typeof ImageDecoder === 'function') {
+    const decoder = new ImageDecoder({ data: bytes, type });
+    return decoder.decode().then((r) => r.image).finally(() => decoder.close());
+  }
+  return createImageBitmap(new Blob([bytes], { type }));
 }
 
+function drawImage(name, image, sequence) {
+  const c = $('img-' + name);
+  const w = image.displayWidth || image.width, h = image.displayHeight || image.height;
+  if (c.width !== w || c.height !== h) {
+    c.width = w;
+    c.height = h;
+  }
+  c.getContext('2d').drawImage(image, 0, 0);
+  c.dataset.sequence = sequence;
+  image.close();
+}
+
+// Told to the server once the frame is drawn: it sends the next frame only then, so this
+// page never gets more frames than it can show (server.hpp). Not after a
+// requestAnimationFrame: a headless or busy browser may hold those back for seconds.
 function onFrame(buffer) {
   const arrived = performance.now();
   const view = new DataView(buffer);
@@ -209,33 +228,32 @@ function onFrame(buffer) {
   base += (4 - (base % 4)) % 4;
   const blob = {};
   for (const b of header.blobs) blob[b.name] = { b, start: base + b.offset };
-  const images = [];
-  for (const name of ['left', 'right', 'disparity', 'top', 'front', 'side']) {
-    const e = blob[name];
-    if (!e) continue;
-    const url = URL.createObjectURL(new Blob([new Uint8Array(buffer, e.start, e.b.size)], { type: e.b.type }));
-    const img = $('img-' + name);
-    img.src = url;
-    img.dataset.sequence = header.sequence;
-    if (objectUrls[name]) URL.revokeObjectURL(objectUrls[name]);
-    objectUrls[name] = url;
-    images.push(img);
-  }
-  // The 3D view is drawn again only here, when a new cloud has come (or on a drag).
-  if (blob.cloud_xyz) {
-    const xyz = new Float32Array(buffer.slice(blob.cloud_xyz.start, blob.cloud_xyz.start + blob.cloud_xyz.b.size));
-    cloudView.setPoints(xyz, header.cloud.frame);
-  }
-  window.binocle.framesReceived += 1;
-  window.binocle.lastHeader = header;
-  $('frame-counter').textContent = header.frames_processed;
-  $('sequence').textContent = header.sequence;
-  $('frames-shown').textContent = window.binocle.framesReceived;
-  $('fps').textContent = header.pipeline_fps !== null ? `${header.pipeline_fps.toFixed(1)} fps` : '';
-  drawScale(header.disparity_scale);
-  showFigures(header);
-  setText($('source-stats'), header.source_statistics || '(the source reports none)');
-  shown(images, arrived);
+  const names = imageNames.filter((name) => blob[name]);
+  const decoded = names.map((name) => decodeImage(new Uint8Array(buffer, blob[name].start, blob[name].b.size), blob[name].b.type));
+  // Everything the frame changes is changed in one task, once its images are decoded: the
+  // browser lays out, paints and composites once per frame, not once per image.
+  Promise.allSettled(decoded).then((results) => {
+    results.forEach((r, i) => {
+      if (r.status === 'fulfilled') drawImage(names[i], r.value, header.sequence);
+      else console.warn(`frame ${header.sequence}: image ${names[i]} not decoded: ${r.reason}`);
+    });
+    // The 3D view is drawn again only here, when a new cloud has come (or on a drag).
+    if (blob.cloud_xyz) {
+      const xyz = new Float32Array(buffer.slice(blob.cloud_xyz.start, blob.cloud_xyz.start + blob.cloud_xyz.b.size));
+      cloudView.setPoints(xyz, header.cloud.frame);
+    }
+    window.binocle.framesReceived += 1;
+    window.binocle.lastHeader = header;
+    setText($('frame-counter'), String(header.frames_processed));
+    setText($('sequence'), String(header.sequence));
+    setText($('frames-shown'), String(window.binocle.framesReceived));
+    setText($('fps'), header.pipeline_fps !== null ? `${header.pipeline_fps.toFixed(1)} fps` : '');
+    drawScale(header.disparity_scale);
+    showFigures(header);
+    setText($('source-stats'), header.source_statistics || '(the source reports none)');
+    window.binocle.showMs += performance.now() - arrived;
+    send({ op: 'shown' });
+  });
 }
 
 // Changes the DOM only where the text changed: less for the browser to lay out and paint.
