@@ -6,7 +6,9 @@
 #include "core/error.hpp"
 
 #include "input/image_file.hpp"
+#include "input/yaml_file.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <sstream>
@@ -140,6 +142,25 @@ void StereoCalibration::validate(const std::string &origin) const {
 }
 
 StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &origin) {
+    // OpenCV's FileStorage parser trusts its input: on some mangled files it never returns
+    // (found by fuzzing: tests/data/bad_calibration/opencv-filestorage-hang.yml, where a
+    // SIGTERM cannot end the run either). So the strict YAML loader reads the text first
+    // (syntax, UTF-8, duplicate keys, with line and column) and only well-formed YAML
+    // reaches FileStorage. OpenCV's "%YAML:1.0" is not a YAML 1.2 directive: it is
+    // blanked (lines and columns stay) before the strict parse; the rest of its line is not.
+    {
+        std::string yaml = text;
+        if (yaml.rfind("%YAML:", 0) == 0)
+            for (size_t i = 0; i < yaml.size() && yaml[i] != '\n' && yaml[i] != ' ' && yaml[i] != '\t' && yaml[i] != '\r' &&
+                               (i < 6 || yaml[i] == '.' || std::isdigit(static_cast<unsigned char>(yaml[i])));
+                 ++i)
+                yaml[i] = ' ';
+        try {
+            input::parseYaml(yaml, origin);
+        } catch (const input::YamlError &e) {
+            throw Error(std::string(e.what()) + " (expected an OpenCV FileStorage YAML calibration)");
+        }
+    }
     cv::FileStorage fs;
     try {
         fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

@@ -70,7 +70,13 @@ YAML::Node parseYaml(const std::string &text, const std::string &origin) {
     }
     YAML::Node root;
     try {
-        root = YAML::Load(text);
+        // Every document is parsed, not only the first: YAML::Load stops after it and
+        // ignores whatever follows, broken or not (a rig with a second `---` block, or a
+        // mangled calibration that OpenCV's own parser then loops on).
+        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+        if (documents.size() > 1)
+            throw YamlError(located(documents[1], origin) + ": a second YAML document begins here; expected one document");
+        if (!documents.empty()) root = documents.front();
     } catch (const YAML::ParserException &e) {
         throw YamlError(at(origin, e.mark) + ": YAML syntax error: " + e.msg);
     } catch (const YAML::Exception &e) {

@@ -5,7 +5,10 @@
 #include "core/calibration.hpp"
 #include "core/error.hpp"
 
+#include <chrono>
+#include <cstdlib>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -18,7 +21,8 @@ namespace {
 
 // Found by the calibration fuzz harness: OpenCV's FileStorage parser threw
 // std::length_error on this mangled file, past the reader's catch (a crash in the harness,
-// a cryptic "basic_string::_M_create" at the CLI). Now a clear binocle::Error naming it.
+// a cryptic "basic_string::_M_create" at the CLI). Now a clear binocle::Error naming it
+// (since the strict YAML loader reads calibrations first, it stops at a second document).
 TEST(CalibrationReader, ParserFailuresOfOpenCvAreBadInputNamingTheFile) {
     const std::string path = std::string(BINOCLE_SOURCE_DIR) + "/tests/data/bad_calibration/fuzz-length-error.yml";
     std::ostringstream text;
@@ -28,9 +32,34 @@ TEST(CalibrationReader, ParserFailuresOfOpenCvAreBadInputNamingTheFile) {
         StereoCalibration::fromYaml(text.str(), "fuzz-length-error.yml");
         FAIL() << "the mangled calibration was accepted";
     } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find("fuzz-length-error.yml: not an OpenCV FileStorage YAML calibration"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("fuzz-length-error.yml:26:1: a second YAML document begins here; expected one document (expected an OpenCV FileStorage YAML calibration)"), std::string::npos)
             << e.what();
     }
+}
+
+// Found by the calibration fuzz harness: OpenCV's FileStorage parser never returned on
+// this 108-byte file (and a SIGTERM could not end the run that read it). The strict YAML
+// loader reads a calibration first, so it is refused at once, naming file, line and byte.
+TEST(CalibrationReader, TextThatHangsOpenCvsParserIsRefusedBeforeIt) {
+    const std::string path = std::string(BINOCLE_SOURCE_DIR) + "/tests/data/bad_calibration/opencv-filestorage-hang.yml";
+    std::ostringstream text;
+    text << std::ifstream(path, std::ios::binary).rdbuf();
+    ASSERT_EQ(text.str().size(), 108u) << path;
+    // A hang would stall the whole suite: the read runs aside and the test gives up on it.
+    auto read = std::async(std::launch::async, [s = text.str()]() -> std::string {
+        try {
+            StereoCalibration::fromYaml(s, "opencv-filestorage-hang.yml");
+            return "accepted";
+        } catch (const Error &e) {
+            return e.what();
+        }
+    });
+    if (read.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+        ADD_FAILURE() << "reading the calibration did not end within 10 s";
+        std::_Exit(1); // the reading thread cannot be stopped
+    }
+    EXPECT_EQ(read.get(), "opencv-filestorage-hang.yml:1:17: byte 0x93 is not valid UTF-8; expected a UTF-8 text "
+                          "(YAML files are UTF-8) (expected an OpenCV FileStorage YAML calibration)");
 }
 
 TEST(CalibrationFiles, ConfigurationNames) {
