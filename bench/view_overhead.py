@@ -8,7 +8,8 @@
 # machine (other users of a shared box included), in cores (1.0 = one core busy).
 #
 # usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10]
-#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--json FILE]
+#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--swiftshader-compositing]
+#        [--json FILE]
 #   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH (absolute) as for the CLI.
 # Run it inside scripts/netns-test.sh to keep everything on loopback.
 import argparse
@@ -36,6 +37,9 @@ parser.add_argument("--json", help="also write the medians and every round here"
 parser.add_argument("--page-draws-nothing", action="store_true",
                     help="the page takes and acknowledges every frame but draws none: the viewer's own cost "
                          "(copy, encoding, sending) without the browser's rendering")
+parser.add_argument("--swiftshader-compositing", action="store_true",
+                    help="Chromium composites the page through SwiftShader too (a testing-only path; by default it "
+                         "composites in software, as Chrome without a usable GPU does; WebGL is on SwiftShader either way)")
 args = parser.parse_args()
 cli = os.environ.get("BINOCLE_CLI", os.path.join(root, "build/bin/binocle"))
 TICK = os.sysconf("SC_CLK_TCK")
@@ -98,7 +102,7 @@ def measure(with_browser):
     driver = None
     try:
         if with_browser:
-            driver = start_browser()
+            driver = start_browser(swiftshader_compositing=args.swiftshader_compositing)
             driver.get(url)
             end = time.time() + 60
             while driver.execute_script("return window.binocle.framesReceived") < 1 and time.time() < end:
@@ -148,7 +152,8 @@ def med(which, key):
 
 
 ratios = [x["with"]["pipeline_fps"] / x["without"]["pipeline_fps"] for x in rounds if x["without"]["pipeline_fps"] > 0]
-result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_draws_nothing": args.page_draws_nothing, "rounds": args.rounds, "window_s": args.seconds,
+result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_draws_nothing": args.page_draws_nothing,
+          "swiftshader_compositing": args.swiftshader_compositing, "rounds": args.rounds, "window_s": args.seconds,
           "cores": os.cpu_count(),
           "fps_without_browser": round(med("without", "pipeline_fps"), 2),
           "fps_with_browser": round(med("with", "pipeline_fps"), 2),

@@ -14,7 +14,7 @@ CHROMIUM = os.environ.get("BINOCLE_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("BINOCLE_CHROMEDRIVER", "/usr/bin/chromedriver")
 
 
-def start_browser(width=1600, height=1100):
+def start_browser(width=1600, height=1100, swiftshader_compositing=False):
     for path, package in ((CHROMIUM, "chromium"), (CHROMEDRIVER, "chromium-driver")):
         if not os.path.exists(path):
             sys.exit(f"browser test: {path} is missing (apt-get install {package})")
@@ -24,13 +24,15 @@ def start_browser(width=1600, height=1100):
     # Chrome does on a machine without a usable GPU. --use-angle=swiftshader alone would
     # also composite through SwiftShader, a testing-only path that redraws the whole window
     # in emulated shaders for every frame the page changes (50-70 ms of CPU per frame at
-    # this size, measured with bench/view_overhead.py): the cost of this box's emulation,
-    # not of the page.
+    # this size, measured with bench/view_overhead.py --swiftshader-compositing): the cost
+    # of this box's emulation, not of the page.
     for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", f"--window-size={width},{height}",
-                "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-compositing", "--no-first-run",
+                "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-first-run",
                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
                 "--proxy-server=127.0.0.1:9"):  # nothing but loopback (bypassed by default) gets out
         options.add_argument(arg)
+    if not swiftshader_compositing:
+        options.add_argument("--disable-gpu-compositing")
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     return webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
 

@@ -122,6 +122,31 @@ try:
     cloud_note = driver.find_element("id", "cloud-note").text
     check("points shown" in cloud_note and "ground frame" in cloud_note, f"the 3D view draws the cloud: {cloud_note!r}")
     shown_points = int(cloud_note.split()[0])
+    # What the WebGL view put on the screen (a WebGL canvas cannot be read back once
+    # composited): the browser's own screenshot of it, its pixels counted in the page.
+    # Points are coloured by height; the clear colour and the grid's grey are not.
+    x, y, w, h = driver.execute_script(
+        "const r = document.getElementById('cloud').getBoundingClientRect(); return [r.x, r.y, r.width, r.height];")
+    png = driver.execute_cdp_cmd("Page.captureScreenshot", {
+        "format": "png", "captureBeyondViewport": True,
+        "clip": {"x": x, "y": y + driver.execute_script("return window.scrollY"), "width": w, "height": h, "scale": 1}})["data"]
+    coloured = driver.execute_async_script("""
+        const done = arguments[arguments.length - 1];
+        const img = new Image();
+        img.onload = () => {
+          const c = document.createElement('canvas'); c.width = img.width; c.height = img.height;
+          const g = c.getContext('2d'); g.drawImage(img, 0, 0);
+          const d = g.getImageData(0, 0, c.width, c.height).data;
+          let n = 0;
+          for (let i = 0; i < d.length; i += 4) {
+            const r = d[i], gr = d[i + 1], b = d[i + 2];
+            if (Math.max(r, gr, b) - Math.min(r, gr, b) > 40) n++;  // not a grey nor the dark blue-grey clear colour
+          }
+          done(n);
+        };
+        img.src = 'data:image/png;base64,' + arguments[0];
+    """, png)
+    check(coloured > 200, f"the WebGL view shows the cloud's points ({coloured} coloured pixels)")
     check(0 < shown_points <= CLOUD_POINTS < driver.execute_script("return window.binocle.lastHeader.points"),
           f"--cloud-points bounds the 3D view: {shown_points} of "
           f"{driver.execute_script('return window.binocle.lastHeader.points')} points")
