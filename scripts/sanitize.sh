@@ -31,24 +31,41 @@ if [ ! -f "$dir/build.ninja" ]; then
     -DBINOCLE_FUZZ_SECONDS="$seconds" "${launcher[@]}"
 fi
 cmake -S . -B "$dir" -DBINOCLE_FUZZ_SECONDS="$seconds" >/dev/null
-# The executables of the labelled tests (tests/CMakeLists.txt collects them).
-mapfile -t targets < <(grep -v '^$' "$dir/sanitize-targets.txt")
+# The executables of the labelled tests (tests/CMakeLists.txt collects them, one
+# "<target> <gtest filter>" per line).
+mapfile -t lines < <(grep -v '^$' "$dir/sanitize-targets.txt")
+targets=()
+for line in "${lines[@]}"; do targets+=("${line%% *}"); done
 cmake --build "$dir" -j "$jobs" --target binocle "${targets[@]}" binocle_fuzzers
 built=$(date +%s)
 # Leak detection is off: the plugins' libraries (OpenCV's thread pool, GLib, Aravis)
 # keep allocations for the life of the process by design.
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-# The labelled executables themselves, each running all its tests (gtest_discover_tests
-# keeps only a test's first label, so `ctest -L sanitize` would find none of them).
+# The labelled executables themselves, each running its tests (gtest_discover_tests
+# keeps only a test's first label, so `ctest -L sanitize` would find none of them),
+# $jobs at a time; each one's output goes to its log, printed when it fails.
 export BINOCLE_PLUGIN_PATH="$PWD/$dir/lib/binocle/plugins"
+mkdir -p "$dir/sanitize-logs"
+run_one() { # <target> <gtest filter>
+  local exe log t0 status=0
+  exe=$(find "$dir/tests" -type f -name "$1" -perm -u+x | head -n 1)
+  log="$PWD/$dir/sanitize-logs/$1.log"
+  [ -n "$exe" ] || { echo "sanitize: no executable for $1" >&2; return 1; }
+  t0=$(date +%s)
+  (cd "$(dirname "$exe")" && timeout 900 "./$1" --gtest_brief=1 "--gtest_filter=$2") >"$log" 2>&1 || status=$?
+  if [ "$status" = 0 ]; then
+    echo "== $1 (ASan + UBSan, filter $2): passed in $(( $(date +%s) - t0 )) s"
+  else
+    cat "$log"
+    echo "sanitize: $1 FAILED (exit $status; log: $log)" >&2
+    return 1
+  fi
+}
+export -f run_one
+export dir
 failed=0
-for t in "${targets[@]}"; do
-  exe=$(find "$dir/tests" -type f -name "$t" -perm -u+x | head -n 1)
-  [ -n "$exe" ] || { echo "sanitize: no executable for $t" >&2; failed=1; continue; }
-  echo "== $t (ASan + UBSan)"
-  (cd "$(dirname "$exe")" && timeout 900 "./$t" --gtest_brief=1) || { echo "sanitize: $t FAILED" >&2; failed=1; }
-done
+printf '%s\n' "${lines[@]}" | xargs -d '\n' -P "$jobs" -I{} bash -c 'run_one "${0%% *}" "${0#* }"' {} || failed=1
 [ "$failed" = 0 ] || exit 1
 tested=$(date +%s)
 if [ "${BINOCLE_SKIP_FUZZ:-0}" != 1 ]; then

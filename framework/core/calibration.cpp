@@ -6,6 +6,8 @@
 #include "core/error.hpp"
 
 #include "input/image_file.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 #include "input/yaml_file.hpp"
 
 #include <cctype>
@@ -48,37 +50,6 @@ void StereoCalibration::computeRectification() {
     cv::stereoRectify(M1, D1, M2, D2, image_size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0, image_size);
 }
 
-namespace {
-
-cv::Mat readMatrix(const cv::FileStorage &fs, const char *key, int rows, int cols, const std::string &origin,
-                   bool required = true) {
-    cv::FileNode n = fs[key];
-    if (n.empty()) {
-        if (required) throw Error(origin + ": calibration key '" + key + "' is missing (expected a " + std::to_string(rows) +
-                                  "x" + std::to_string(cols) + " matrix)");
-        return {};
-    }
-    // The declared size first: "rows: 100000000" must not allocate before being refused.
-    if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt() || n["rows"].real() < 1 || n["cols"].real() < 1 ||
-        n["rows"].real() * n["cols"].real() > 16)
-        throw Error(origin + ": calibration key '" + key + "' is not a small OpenCV matrix (expected !!opencv-matrix with " +
-                    (rows > 0 ? std::to_string(rows) + "x" + std::to_string(cols) : std::string("at most 16 values")) + ")");
-    cv::Mat m;
-    try {
-        n >> m;
-    } catch (const cv::Exception &) {
-        throw Error(origin + ": calibration key '" + key + "' is not an OpenCV matrix (!!opencv-matrix)");
-    }
-    if (m.empty()) throw Error(origin + ": calibration key '" + key + "' is empty");
-    m.convertTo(m, CV_64F);
-    if (rows > 0 && cols > 0 && m.total() == static_cast<size_t>(rows * cols)) m = m.reshape(1, rows);
-    if ((rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols))
-        throw Error(origin + ": calibration key '" + key + "' is " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
-                    ", expected " + std::to_string(rows) + "x" + std::to_string(cols));
-    return m;
-}
-
-} // namespace
 
 namespace {
 
@@ -89,18 +60,73 @@ std::string number(double v) {
     return s.str();
 }
 
+// A calibration's text is read with the strict YAML loader and these readers, not with
+// OpenCV's FileStorage: FileStorage trusts its input, and on some mangled files (well-formed
+// YAML included) it never returns; found by fuzzing, tests/data/bad_calibration/. Numbers
+// go through the one strict reader (input::parseReal), sizes are checked before anything
+// is allocated, and the messages say where ("file:line:column").
+
+// One value of a calibration as a real number; .nan and .inf are read (and refused where
+// they matter, with the key and the position in the matrix).
+double readReal(const YAML::Node &n, const std::string &what, const std::string &origin) {
+    double v = 0;
+    std::string why;
+    if (!n.IsScalar() || !input::parseReal(n.Scalar(), v, &why, true))
+        throw Error(input::located(n, origin) + ": calibration key " + what +
+                    (n.IsScalar() ? " = '" + input::printable(n.Scalar(), 40) + "': " + why : ": expected a number"));
+    return v;
+}
+
 // image_width / image_height: whole, positive, within the image limits; read as real
 // numbers first so that 1e300 or 640.5 are refused instead of cast.
-int imageSide(const cv::FileStorage &fs, const char *key, const std::string &origin) {
-    const cv::FileNode n = fs[key];
-    if (n.empty()) throw Error(origin + ": calibration key '" + key + "' is missing (expected the image size in pixels)");
-    if (!n.isInt() && !n.isReal())
-        throw Error(origin + ": calibration key '" + key + "' is not a number (expected the image size in pixels)");
-    const double v = n.real();
+int imageSide(const YAML::Node &root, const char *key, const std::string &origin) {
+    const YAML::Node n = root[key];
+    if (!n) throw Error(origin + ": calibration key '" + key + "' is missing (expected the image size in pixels)");
+    const double v = readReal(n, std::string("'") + key + "'", origin);
     if (!(v >= 1 && v <= static_cast<double>(input::kMaxImageSide)) || v != std::floor(v))
         throw Error(origin + ": calibration key '" + key + "' = " + number(v) + ": expected a whole number of pixels 1.." +
                     std::to_string(input::kMaxImageSide));
     return static_cast<int>(v);
+}
+
+// An OpenCV matrix as FileStorage writes it: !!opencv-matrix {rows, cols, dt, data}. At
+// most 16 values; the declared size is checked before anything is read or allocated.
+cv::Mat readMatrix(const YAML::Node &root, const char *key, int rows, int cols, const std::string &origin,
+                   bool required = true) {
+    const YAML::Node n = root[key];
+    const std::string shape = rows > 0 ? std::to_string(rows) + "x" + std::to_string(cols) : std::string("at most 16 values");
+    if (!n) {
+        if (required) throw Error(origin + ": calibration key '" + key + "' is missing (expected a " + shape + " matrix)");
+        return {};
+    }
+    const std::string name = std::string("'") + key + "'";
+    const std::string notMatrix = origin + ": calibration key " + name + " is not a small OpenCV matrix (expected !!opencv-matrix with " + shape + ")";
+    if (!n.IsMap()) throw Error(notMatrix);
+    if (const auto unknown = input::findUnknownKey(n, {"rows", "cols", "dt", "data"}))
+        throw Error(input::located(unknown->key, origin) + ": calibration key " + name + ": " + unknown->message);
+    int64_t size[2] = {0, 0};
+    for (int i = 0; i < 2; ++i) {
+        const YAML::Node d = n[i == 0 ? "rows" : "cols"];
+        if (!d || !d.IsScalar() || !input::parseInteger(d.Scalar(), size[i], nullptr, 1, 16)) throw Error(notMatrix);
+    }
+    if (size[0] * size[1] > 16) throw Error(notMatrix);
+    if (const YAML::Node dt = n["dt"]; dt && !(dt.IsScalar() && (dt.Scalar() == "d" || dt.Scalar() == "f")))
+        throw Error(input::located(dt, origin) + ": calibration key " + name + ": dt '" +
+                    input::printable(dt.IsScalar() ? dt.Scalar() : std::string("(not a scalar)"), 20) +
+                    "': expected d (double) or f (float)");
+    const YAML::Node data = n["data"];
+    const auto total = static_cast<size_t>(size[0] * size[1]);
+    if (!data || !data.IsSequence() || data.size() != total)
+        throw Error(input::located(data ? data : n, origin) + ": calibration key " + name + ": expected 'data' to hold " +
+                    std::to_string(total) + " numbers (rows x cols)" +
+                    (data && data.IsSequence() ? ", it holds " + std::to_string(data.size()) : std::string()));
+    cv::Mat m(static_cast<int>(size[0]), static_cast<int>(size[1]), CV_64F);
+    for (size_t i = 0; i < total; ++i) m.at<double>(static_cast<int>(i)) = readReal(data[i], name, origin);
+    if (rows > 0 && cols > 0 && m.total() == static_cast<size_t>(rows * cols)) m = m.reshape(1, rows);
+    if ((rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols))
+        throw Error(origin + ": calibration key " + name + " is " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
+                    ", expected " + std::to_string(rows) + "x" + std::to_string(cols));
+    return m;
 }
 
 void requireFinite(const cv::Mat &m, const char *key, const std::string &origin) {
@@ -142,44 +168,35 @@ void StereoCalibration::validate(const std::string &origin) const {
 }
 
 StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &origin) {
-    // OpenCV's FileStorage parser trusts its input: on some mangled files it never returns
-    // (found by fuzzing: tests/data/bad_calibration/opencv-filestorage-hang.yml, where a
-    // SIGTERM cannot end the run either). So the strict YAML loader reads the text first
-    // (syntax, UTF-8, duplicate keys, with line and column) and only well-formed YAML
-    // reaches FileStorage. OpenCV's "%YAML:1.0" is not a YAML 1.2 directive: it is
-    // blanked (lines and columns stay) before the strict parse; the rest of its line is not.
-    {
-        std::string yaml = text;
-        if (yaml.rfind("%YAML:", 0) == 0)
-            for (size_t i = 0; i < yaml.size() && yaml[i] != '\n' && yaml[i] != ' ' && yaml[i] != '\t' && yaml[i] != '\r' &&
-                               (i < 6 || yaml[i] == '.' || std::isdigit(static_cast<unsigned char>(yaml[i])));
-                 ++i)
-                yaml[i] = ' ';
-        try {
-            input::parseYaml(yaml, origin);
-        } catch (const input::YamlError &e) {
-            throw Error(std::string(e.what()) + " (expected an OpenCV FileStorage YAML calibration)");
-        }
-    }
-    cv::FileStorage fs;
+    // OpenCV writes "%YAML:1.0" as its first line; that is not a YAML 1.2 directive, so it
+    // is blanked (lines and columns stay) before the strict parse; the rest of its line is not.
+    std::string yaml = text;
+    if (yaml.rfind("%YAML:", 0) == 0)
+        for (size_t i = 0; i < yaml.size() && (i < 6 || yaml[i] == '.' || std::isdigit(static_cast<unsigned char>(yaml[i]))); ++i)
+            yaml[i] = ' ';
+    YAML::Node root;
     try {
-        fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-    } catch (const cv::Exception &e) {
-        throw Error(origin + ": not an OpenCV FileStorage YAML calibration: " + e.err);
-    } catch (const std::exception &e) {
-        // OpenCV's parser lets some std:: errors through (found by fuzzing: a length_error
-        // from a mangled scalar); they are bad input all the same.
-        throw Error(origin + ": not an OpenCV FileStorage YAML calibration: the parser failed (" + e.what() + ")");
+        root = input::parseYaml(yaml, origin);
+    } catch (const input::YamlError &e) {
+        throw Error(std::string(e.what()) + " (expected an OpenCV FileStorage YAML calibration)");
     }
-    if (!fs.isOpened()) throw Error(origin + ": not an OpenCV FileStorage YAML calibration (expected '%YAML:1.0' and keys M1, D1, ...)");
+    if (!root.IsMap())
+        throw Error(origin + ": not a calibration: expected a map of keys (image_width, image_height, M1, D1, M2, D2, R, T)");
+    // The keys written by toYaml() (R1 ... Q, baseline_mm and focal_length_px are derived:
+    // read again from M1 ... T, not from the file); any other key is a mistake.
+    if (const auto unknown = input::findUnknownKey(root, {"image_width", "image_height", "configuration", "rectified", "M1", "D1",
+                                                          "M2", "D2", "R", "T", "R1", "R2", "P1", "P2", "Q", "baseline_mm",
+                                                          "focal_length_px", "rms_px"},
+                                                   "in a calibration"))
+        throw Error(input::located(unknown->key, origin) + ": " + unknown->message);
     StereoCalibration c;
     try {
-        const int w = imageSide(fs, "image_width", origin), h = imageSide(fs, "image_height", origin);
+        const int w = imageSide(root, "image_width", origin), h = imageSide(root, "image_height", origin);
         c.image_size = cv::Size(w, h);
-        c.M1 = readMatrix(fs, "M1", 3, 3, origin);
-        c.M2 = readMatrix(fs, "M2", 3, 3, origin);
-        c.D1 = readMatrix(fs, "D1", 0, 0, origin, false);
-        c.D2 = readMatrix(fs, "D2", 0, 0, origin, false);
+        c.M1 = readMatrix(root, "M1", 3, 3, origin);
+        c.M2 = readMatrix(root, "M2", 3, 3, origin);
+        c.D1 = readMatrix(root, "D1", 0, 0, origin, false);
+        c.D2 = readMatrix(root, "D2", 0, 0, origin, false);
         if (c.D1.empty()) c.D1 = cv::Mat::zeros(1, 5, CV_64F);
         if (c.D2.empty()) c.D2 = cv::Mat::zeros(1, 5, CV_64F);
         c.D1 = c.D1.reshape(1, 1);
@@ -188,15 +205,18 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
             if (D->cols != 4 && D->cols != 5 && D->cols != 8 && D->cols != 12 && D->cols != 14)
                 throw Error(origin + ": calibration key '" + key + "' holds " + std::to_string(D->cols) +
                             " coefficients; expected 4, 5, 8, 12 or 14 (OpenCV's distortion models)");
-        c.R = readMatrix(fs, "R", 3, 3, origin);
-        c.T = readMatrix(fs, "T", 3, 1, origin);
-        if (const cv::FileNode r = fs["rectified"]; !r.empty()) {
-            if (!r.isInt() || (r.real() != 0 && r.real() != 1))
-                throw Error(origin + ": calibration key 'rectified' must be 0 or 1");
-            c.rectified = static_cast<int>(r) != 0;
+        c.R = readMatrix(root, "R", 3, 3, origin);
+        c.T = readMatrix(root, "T", 3, 1, origin);
+        if (const YAML::Node r = root["rectified"]) {
+            if (!r.IsScalar() || (r.Scalar() != "0" && r.Scalar() != "1"))
+                throw Error(input::located(r, origin) + ": calibration key 'rectified' must be 0 or 1");
+            c.rectified = r.Scalar() == "1";
         }
-        if (const cv::FileNode r = fs["rms_px"]; !r.empty() && (r.isReal() || r.isInt())) c.rms_px = r.real();
-        if (const cv::FileNode n = fs["configuration"]; !n.empty() && n.isString()) c.configuration = n.string();
+        if (const YAML::Node r = root["rms_px"]) c.rms_px = readReal(r, "'rms_px'", origin);
+        if (const YAML::Node n = root["configuration"]) {
+            if (!n.IsScalar()) throw Error(input::located(n, origin) + ": calibration key 'configuration': expected a name");
+            c.configuration = n.Scalar();
+        }
         c.validate(origin);
         c.computeRectification();
     } catch (const cv::Exception &e) {

@@ -8,8 +8,11 @@
 //   M1, D1, M2, D2              matrix  intrinsics and distortion of left / right
 //   R, T                        matrix  right camera w.r.t. left (x_r = R x_l + T), T in mm
 //   rectified                   int     1: images are already rectified (R1 = R2 = I)
-//   R1, R2, P1, P2, Q           matrix  rectification (written; recomputed on load if absent)
+//   R1, R2, P1, P2, Q           matrix  rectification (written; recomputed on load)
 //   baseline_mm, focal_length_px, rms_px, configuration   informative
+// Written with FileStorage; read with the strict YAML loader (FileStorage's parser does
+// not return on some mangled files): any other key, a second document, a duplicate key
+// or a number that is not plain decimal is refused with its line and column.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -40,7 +43,8 @@ struct StereoCalibration {
     static constexpr double kMaxBaselineMm = 1e6; // 1 km: a larger one is a unit mistake
 
     // Parse FileStorage YAML text. `origin` names the file in errors. Throws binocle::Error
-    // naming the origin and the key that is missing or malformed.
+    // naming the origin, the key that is missing or malformed and, where it has one, its
+    // line and column.
     static StereoCalibration fromYaml(const std::string &text, const std::string &origin);
     static StereoCalibration load(const std::string &path);
     std::string toYaml() const;

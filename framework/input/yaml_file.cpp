@@ -4,6 +4,8 @@
 
 #include "input/text.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -57,6 +60,34 @@ void checkDuplicateKeys(const YAML::Node &root, const std::string &origin) {
     }
 }
 
+namespace {
+
+// Where a second document begins, if the text holds one (or anything after the first).
+// The parser is asked for two documents at most: it is its own loop that never ends.
+std::optional<YAML::Mark> secondDocument(const std::string &text) {
+    struct Events : YAML::EventHandler {
+        int documents = 0;
+        YAML::Mark second;
+        void OnDocumentStart(const YAML::Mark &mark) override {
+            if (++documents == 2) second = mark;
+        }
+        void OnDocumentEnd() override {}
+        void OnNull(const YAML::Mark &, YAML::anchor_t) override {}
+        void OnAlias(const YAML::Mark &, YAML::anchor_t) override {}
+        void OnScalar(const YAML::Mark &, const std::string &, YAML::anchor_t, const std::string &) override {}
+        void OnSequenceStart(const YAML::Mark &, const std::string &, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+        void OnSequenceEnd() override {}
+        void OnMapStart(const YAML::Mark &, const std::string &, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+        void OnMapEnd() override {}
+    } events;
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    if (!parser.HandleNextDocument(events) || !parser.HandleNextDocument(events)) return std::nullopt;
+    return events.second;
+}
+
+} // namespace
+
 YAML::Node parseYaml(const std::string &text, const std::string &origin) {
     size_t bad = 0;
     if (!isValidUtf8(text, &bad)) {
@@ -70,13 +101,13 @@ YAML::Node parseYaml(const std::string &text, const std::string &origin) {
     }
     YAML::Node root;
     try {
-        // Every document is parsed, not only the first: YAML::Load stops after it and
-        // ignores whatever follows, broken or not (a rig with a second `---` block, or a
-        // mangled calibration that OpenCV's own parser then loops on).
-        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-        if (documents.size() > 1)
-            throw YamlError(located(documents[1], origin) + ": a second YAML document begins here; expected one document");
-        if (!documents.empty()) root = documents.front();
+        root = YAML::Load(text);
+        // YAML::Load stops after the first document and ignores whatever follows, broken
+        // or not (a rig with a second `---` block; a mangled calibration). So the text is
+        // parsed again, events only, for one more document. Not with YAML::LoadAll: on
+        // stray tokens after a document it loops for ever, allocating (found by fuzzing).
+        if (const auto second = secondDocument(text))
+            throw YamlError(at(origin, *second) + ": more follows the first YAML document here; expected one document");
     } catch (const YAML::ParserException &e) {
         throw YamlError(at(origin, e.mark) + ": YAML syntax error: " + e.msg);
     } catch (const YAML::Exception &e) {

@@ -150,7 +150,7 @@ TEST(Yaml, DuplicateKeysBadUtf8AndSyntaxSayWhere) {
     EXPECT_EQ(yamlError("a: 1\nb: {c: 1, d: 2}\n"), "");
     // Whatever follows the first document is read too: a second one is refused, and a
     // broken tail is a syntax error, not silently dropped (YAML::Load stops after one).
-    EXPECT_EQ(yamlError("a: 1\n---\nb: 2\n"), "x.yaml:3:1: a second YAML document begins here; expected one document");
+    EXPECT_EQ(yamlError("a: 1\n---\nb: 2\n"), "x.yaml:2:1: more follows the first YAML document here; expected one document");
     EXPECT_EQ(yamlError("a: 1\n%YAML 1.2\n[x\n"), "x.yaml:4:1: YAML syntax error: end of sequence flow not found");
     EXPECT_EQ(yamlError(""), "");
     // An alias bomb: each level refers to the one before nine times; checked once each.
