@@ -8,7 +8,7 @@
 # machine (other users of a shared box included), in cores (1.0 = one core busy).
 #
 # usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10]
-#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--swiftshader-compositing]
+#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--page-without-cloud] [--swiftshader-compositing]
 #        [--json FILE]
 #   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH (absolute) as for the CLI.
 # Run it inside scripts/netns-test.sh to keep everything on loopback.
@@ -37,6 +37,8 @@ parser.add_argument("--json", help="also write the medians and every round here"
 parser.add_argument("--page-draws-nothing", action="store_true",
                     help="the page takes and acknowledges every frame but draws none: the viewer's own cost "
                          "(copy, encoding, sending) without the browser's rendering")
+parser.add_argument("--page-without-cloud", action="store_true",
+                    help="the page draws everything but the 3D view: what the WebGL point view costs the browser")
 parser.add_argument("--swiftshader-compositing", action="store_true",
                     help="Chromium composites the page through SwiftShader too (a testing-only path; by default it "
                          "composites in software, as Chrome without a usable GPU does; WebGL is on SwiftShader either way)")
@@ -109,6 +111,8 @@ def measure(with_browser):
                 time.sleep(0.1)
             if args.page_draws_nothing:  # the page's frame handler, replaced by a count and the acknowledgement
                 driver.execute_script("onFrame = function () { window.binocle.framesReceived += 1; send({op: 'shown'}); };")
+            if args.page_without_cloud:  # the 3D view keeps its first cloud
+                driver.execute_script("cloudView.setPoints = function () {};")
         time.sleep(args.warmup)
         browser = descendants(driver.service.process.pid) if driver else []
         n0, t0 = frames(port, token)
@@ -153,6 +157,7 @@ def med(which, key):
 
 ratios = [x["with"]["pipeline_fps"] / x["without"]["pipeline_fps"] for x in rounds if x["without"]["pipeline_fps"] > 0]
 result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_draws_nothing": args.page_draws_nothing,
+          "page_without_cloud": args.page_without_cloud,
           "swiftshader_compositing": args.swiftshader_compositing, "rounds": args.rounds, "window_s": args.seconds,
           "cores": os.cpu_count(),
           "fps_without_browser": round(med("without", "pipeline_fps"), 2),
