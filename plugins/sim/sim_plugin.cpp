@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 namespace binocle::plugins {
 
@@ -84,6 +85,8 @@ public:
             Param::real("forward_mm_per_frame", "0").unit("mm").help("rig displacement along the range axis per frame"),
             Param::real("lateral_mm_per_frame", "0").unit("mm").help("rig displacement along the lateral axis per frame"),
             Param::real("frame_rate_hz", "15").min(0.001).unit("Hz").help("time stamps advance by 1 / frame_rate_hz"),
+            Param::boolean("pace", false)
+                .help("true: frames come no faster than frame_rate_hz, as a camera delivers them; false: as fast as rendered"),
             Param::integer("seed", "1").min(0).max(4294967295.0).help("seed of the sensor noise"),
             Param::real("noise_sigma", "2").min(0).unit("grey levels").help("Gaussian sensor noise, standard deviation"),
             Param::real("gain_right", "1").min(0).help("right imager's response relative to the left"),
@@ -133,6 +136,7 @@ public:
         forward_ = p.real("forward_mm_per_frame");
         lateral_ = p.real("lateral_mm_per_frame");
         periodNs_ = static_cast<int64_t>(1e9 / p.real("frame_rate_hz"));
+        pace_ = p.boolean("pace");
 
         try {
             const std::string board = p.string("calibration_board");
@@ -159,9 +163,12 @@ public:
         }
     }
 
-    std::unique_ptr<sdk::Frame> grab(int32_t /*timeout_ms: rendering does not wait*/) override {
+    void start() override { due_ = std::chrono::steady_clock::now(); }
+
+    std::unique_ptr<sdk::Frame> grab(int32_t timeout_ms) override {
         if (frames_ > 0 && next_ >= static_cast<uint64_t>(frames_))
             throw Error(BINOCLE_ERR_END_OF_STREAM, "sim: all " + std::to_string(frames_) + " frames delivered");
+        if (pace_) waitUntilDue(timeout_ms);
         const auto started = std::chrono::steady_clock::now();
         const uint64_t index = next_++;
         sim::RigPose pose;
@@ -211,6 +218,22 @@ public:
     }
 
 private:
+    // pace: frames are due one period apart, from start(); a late consumer gets the next
+    // frame at once but no burst of frames to catch up (as replay's rate_hz).
+    void waitUntilDue(int32_t timeout_ms) {
+        using namespace std::chrono;
+        const auto now = steady_clock::now();
+        if (due_ > now) {
+            if (timeout_ms >= 0 && due_ - now > milliseconds(timeout_ms)) {
+                std::this_thread::sleep_for(milliseconds(timeout_ms));
+                throw Error(BINOCLE_ERR_TIMEOUT, "sim: next frame due after the timeout of " + std::to_string(timeout_ms) +
+                                                     " ms (pace at frame_rate_hz " + std::to_string(1e9 / periodNs_) + ")");
+            }
+            std::this_thread::sleep_until(due_);
+        }
+        due_ = std::max(due_, steady_clock::now() - nanoseconds(periodNs_)) + nanoseconds(periodNs_);
+    }
+
     static binocle_image view(const cv::Mat &m, int32_t format) {
         return sdk::makeImage(m.cols, m.rows, format, const_cast<uint8_t *>(m.data), static_cast<int32_t>(m.step));
     }
@@ -219,6 +242,8 @@ private:
     std::optional<sim::Renderer> renderer_;
     sim::Scene scene_;
     std::optional<sim::BoardSettings> board_;
+    bool pace_ = false;
+    std::chrono::steady_clock::time_point due_ = std::chrono::steady_clock::now();
     int64_t frames_ = 1;
     double forward_ = 0, lateral_ = 0;
     int64_t periodNs_ = 0;

@@ -104,6 +104,26 @@ TEST(SimPlugin, RangeMotionAndEndOfStream) {
     EXPECT_FALSE(src->grab());
 }
 
+TEST(SimPlugin, PaceDeliversFramesAtTheFrameRateLikeACamera) {
+    // Unpaced (the default): the next frame is rendered at once, whatever the timeout.
+    auto fast = makeSim("{frames: 0, frame_rate_hz: 0.5, antialias: 1}");
+    EXPECT_TRUE(fast->grab(0));
+    EXPECT_TRUE(fast->grab(0));
+    // Paced: the first frame is due at start, the next two seconds later, so a grab that
+    // may not wait is a timeout, as for a camera.
+    auto paced = makeSim("{frames: 0, frame_rate_hz: 0.5, pace: true, antialias: 1}");
+    auto first = paced->grab(0);
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->raw().timestamp_left_ns, 0);
+    try {
+        paced->grab(0);
+        FAIL() << "grab did not wait for the frame rate";
+    } catch (const binocle::PluginError &e) {
+        EXPECT_EQ(e.code(), BINOCLE_ERR_TIMEOUT) << e.what();
+        EXPECT_NE(std::string(e.what()).find("frame_rate_hz"), std::string::npos) << e.what();
+    }
+}
+
 TEST(SimPlugin, MainObjectLateralShiftMovesThePanelAndItsTruth) {
     auto still = makeSim("{range_mm: 6000}");
     auto moved = makeSim("{range_mm: 6000, main_object_lateral_mm: 120}");
