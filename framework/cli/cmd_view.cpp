@@ -66,6 +66,11 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                       ->type_name("N")
                       ->check(atLeast(1))
                       ->capture_default_str();
+                  app.add_option("--cloud-fps", args->options.cloud_fps,
+                                 "most new clouds per second for the 3D view (the images come at --display-fps)")
+                      ->type_name("F")
+                      ->check(positiveNumber())
+                      ->capture_default_str();
                   app.add_option("--frames", args->frames, "stop after N frames (measurements)")->type_name("N")->check(atLeast(1));
                   app.add_flag("--paused", args->options.paused, "start paused on the first frame");
                   return [args] { return view(*args); };

@@ -173,22 +173,24 @@ std::string encodeFrame(const FrameProducts &p, const EncodeOptions &options) {
     for (size_t i = 0; i < views.size(); ++i) add(viewNames[i], "image/jpeg", encodeImage(".jpg", views[i], jpeg));
 
     // The cloud, thinned evenly to what a browser draws smoothly.
-    const Cloud &c = r.cloud;
-    const size_t n = c.size();
-    const size_t stride = std::max<size_t>(1, (n + options.max_cloud_points - 1) / std::max<size_t>(1, options.max_cloud_points));
-    std::vector<float> xyz;
-    std::vector<uint8_t> rgb;
-    for (size_t i = 0; i < n; i += stride) {
-        const float x = c.xyz[3 * i], y = c.xyz[3 * i + 1], z = c.xyz[3 * i + 2];
-        if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
-        xyz.insert(xyz.end(), {x / 1000.f, y / 1000.f, z / 1000.f});
-        if (c.rgb.size() == c.xyz.size()) rgb.insert(rgb.end(), {c.rgb[3 * i], c.rgb[3 * i + 1], c.rgb[3 * i + 2]});
+    if (options.with_cloud) {
+        const Cloud &c = r.cloud;
+        const size_t n = c.size();
+        const size_t stride = std::max<size_t>(1, (n + options.max_cloud_points - 1) / std::max<size_t>(1, options.max_cloud_points));
+        std::vector<float> xyz;
+        std::vector<uint8_t> rgb;
+        for (size_t i = 0; i < n; i += stride) {
+            const float x = c.xyz[3 * i], y = c.xyz[3 * i + 1], z = c.xyz[3 * i + 2];
+            if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+            xyz.insert(xyz.end(), {x / 1000.f, y / 1000.f, z / 1000.f});
+            if (c.rgb.size() == c.xyz.size()) rgb.insert(rgb.end(), {c.rgb[3 * i], c.rgb[3 * i + 1], c.rgb[3 * i + 2]});
+        }
+        header["cloud"] = {{"points", xyz.size() / 3},
+                           {"frame", c.frame == BINOCLE_FRAME_GROUND ? "ground" : "camera"},
+                           {"has_rgb", !rgb.empty()}};
+        add("cloud_xyz", "application/octet-stream", std::string(reinterpret_cast<const char *>(xyz.data()), xyz.size() * sizeof(float)));
+        if (!rgb.empty()) add("cloud_rgb", "application/octet-stream", std::string(rgb.begin(), rgb.end()));
     }
-    header["cloud"] = {{"points", xyz.size() / 3},
-                       {"frame", c.frame == BINOCLE_FRAME_GROUND ? "ground" : "camera"},
-                       {"has_rgb", !rgb.empty()}};
-    add("cloud_xyz", "application/octet-stream", std::string(reinterpret_cast<const char *>(xyz.data()), xyz.size() * sizeof(float)));
-    if (!rgb.empty()) add("cloud_rgb", "application/octet-stream", std::string(rgb.begin(), rgb.end()));
     header["blobs"] = list;
 
     const std::string head = header.dump(-1, ' ', false, OJson::error_handler_t::replace);

@@ -41,12 +41,15 @@ struct EncodeOptions {
     int jpeg_quality = 85;
     int view_px = 320;           // longer side of each density view
     size_t max_cloud_points = 20000; // the cloud is thinned evenly to at most this
+    bool with_cloud = true;      // false: no `cloud` in the header, no cloud blobs (the
+                                 // page keeps the last cloud it got)
     method::GridSpec grid;
 };
 
 // One binary message: a 4-byte little-endian header length, the header (JSON: figures,
-// and `blobs`: [{name, type, offset, size}]), then the blobs (JPEG images, the
-// cloud as float32 x, y, z in metres followed by uint8 r, g, b).
+// and `blobs`: [{name, type, offset, size}]), then the blobs: the JPEG images (left,
+// right, disparity, top, front, side) and, when with_cloud, the cloud as float32 x, y, z
+// in metres (`cloud_xyz`) and uint8 r, g, b (`cloud_rgb`, where the cloud has colours).
 std::string encodeFrame(const FrameProducts &p, const EncodeOptions &options);
 
 // Writes the frame's outputs as `binocle run` does (`outputs` of the rig), plus its

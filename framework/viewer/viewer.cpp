@@ -44,13 +44,18 @@ public:
         updateWanted();
         if (options.display_fps > 0)
             minInterval_ = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options.display_fps));
+        if (options.cloud_fps > 0)
+            cloudInterval_ = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options.cloud_fps));
         encode_.grid = method::GridSpec{};
         encode_.max_cloud_points = options.cloud_points;
     }
 
     ViewSummary run(const std::function<void(const std::string &)> &listening) {
         ServerHandlers h;
-        h.hello = [this] { return dumpJson(state(true)); };
+        h.hello = [this] {
+            cloudWanted_ = true; // a new page: its 3D view gets the next frame's cloud
+            return dumpJson(state(true));
+        };
         h.command = [this](const std::string &c) { return command(c); };
         h.api = [this](const std::string &name) { return api(name); };
         h.lastFrame = [this] {
@@ -266,8 +271,14 @@ private:
             lock.unlock();
             std::shared_ptr<const std::string> message;
             const auto t0 = Clock::now();
+            // The 3D view gets a new cloud at most cloud_fps times a second (drawing one
+            // costs a browser more than the six images), and always while paused (a
+            // stepped frame shows all of itself) or when a page has just opened.
+            EncodeOptions encode = encode_;
+            encode.with_cloud = pausedNow_ || cloudWanted_.exchange(false) || t0 - lastCloud_ >= cloudInterval_;
+            if (encode.with_cloud) lastCloud_ = t0;
             try {
-                message = std::make_shared<const std::string>(encodeFrame(*p, encode_));
+                message = std::make_shared<const std::string>(encodeFrame(*p, encode));
             } catch (const std::exception &e) {
                 spdlog::error("view: frame {} could not be encoded: {}", p->result.sequence, e.what());
             }
@@ -444,7 +455,9 @@ private:
     const ViewOptions options_;
     const PluginHost &host_;
     EncodeOptions encode_;
-    Clock::duration minInterval_{0};
+    Clock::duration minInterval_{0}, cloudInterval_{0};
+    Clock::time_point lastCloud_{}; // encoder thread
+    std::atomic<bool> cloudWanted_{false};
 
     // Guarded by mutex_.
     std::mutex mutex_;

@@ -19,8 +19,9 @@ struct ViewOptions {
     std::string address = "127.0.0.1";
     int port = 8080;                 // 0: any free port
     std::string out_dir = "out/view"; // where snapshots go
-    double display_fps = 5;          // most frames per second sent to the browsers
+    double display_fps = 2;          // most frames per second sent to the browsers
     size_t cloud_points = 20000;     // most points of the 3D view (the cloud thinned evenly)
+    double cloud_fps = 1;            // most new clouds per second for the 3D view
     int64_t max_frames = -1;         // > 0: stop after this many frames (measurements)
     bool paused = false;             // start paused (the first frame is shown)
 };

@@ -43,7 +43,7 @@ def wait_for(predicate, timeout, what):
 
 
 # Bad values of the display's options are usage errors naming the option.
-for option, value in (("--cloud-points", "0"), ("--display-fps", "0")):
+for option, value in (("--cloud-points", "0"), ("--display-fps", "0"), ("--cloud-fps", "0")):
     bad = subprocess.run([cli, "view", rig, option, value], capture_output=True, text=True, timeout=60)
     check(bad.returncode == 2 and option in bad.stderr, f"view {option} {value} is refused: {bad.stderr.strip()[:120]!r}")
 
@@ -102,9 +102,9 @@ try:
         const run = () => {
           const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
           let h = 0; for (let i = 0; i < d.length; i++) h = (h * 31 + d[i]) >>> 0;
-          done([Number(c.dataset.sequence), h, c.width, c.height]);
+          done([window.binocle.drawn.disparity, h, c.width, c.height]);
         };
-        const wait = () => (c.dataset.sequence ? run() : setTimeout(wait, 50));
+        const wait = () => (window.binocle.drawn.disparity !== undefined ? run() : setTimeout(wait, 50));
         wait();
     """
     seq_a, sum_a, w, h = driver.execute_async_script(checksum_js)
@@ -114,9 +114,9 @@ try:
     check(seq_b != seq_a and sum_b != sum_a, f"the disparity image changes between frames {seq_a} and {seq_b}")
 
     for name in ("left", "right", "top", "front", "side"):
-        # Drawn once a frame's image is decoded: the canvas then has its size and a sequence.
-        size = wait_for(lambda: (lambda s: s if s[2] else None)(driver.execute_script(
-            f"const c = document.getElementById('img-{name}'); return [c.width, c.height, c.dataset.sequence || ''];")),
+        # Drawn once a frame's images are decoded: the canvas then has its size and a sequence.
+        size = wait_for(lambda: (lambda s: s if s[2] is not None else None)(driver.execute_script(
+            f"const c = document.getElementById('img-{name}'); return [c.width, c.height, window.binocle.drawn['{name}']];")),
             10, f"panel {name}'s image")
         check(size[0] > 0 and size[1] > 0, f"panel {name} shows an image ({size[0]} x {size[1]})")
     cloud_note = driver.find_element("id", "cloud-note").text
@@ -182,8 +182,10 @@ try:
     wait_for(lambda: driver.execute_script("return window.binocle.lastHeader.matcher.num_disparities") == 128, 90,
              "the matcher to report 128 disparities (replies: %s)" % driver.execute_script(
                  "return window.binocle.replies.map(r => r.type + ' ' + (r.message || r.last_change || ''))"))
-    shown = driver.execute_script(
-        "return document.querySelector('#figures tr[data-figure=\"matcher range\"] td.value').textContent")
+    # The page's text follows within a second (it changes at most twice a second).
+    figure_js = "return document.querySelector('#figures tr[data-figure=\"matcher range\"] td.value').textContent"
+    shown = wait_for(lambda: (lambda t: t if "128" in t else None)(driver.execute_script(figure_js)), 5,
+                     "the figures to show the new range")
     check(before == 64 and "128" in shown, f"num_disparities 64 -> 128 re-creates the matcher (figures: {shown!r})")
     check("--set matcher.num_disparities=128" in driver.find_element("id", "set-lines").get_attribute("value"),
           "the change is listed as a --set line")

@@ -217,6 +217,16 @@ TEST(ViewerFrame, MessageLayout) {
     EXPECT_GT(cv::norm(cv::Vec3d(d.at<cv::Vec3b>(16, 20))), 100.0);
     for (const auto &b : h["blobs"]) // cheap encodings only: no PNG in a live frame
         if (b["name"] != "cloud_xyz" && b["name"] != "cloud_rgb") EXPECT_EQ(b["type"], "image/jpeg") << b["name"];
+
+    // Without the cloud (the 3D view's own rate): no cloud in the header, no cloud blobs.
+    o.with_cloud = false;
+    const std::string lean = viewer::encodeFrame(p, o);
+    const uint32_t leanLen = uint8_t(lean[0]) | uint8_t(lean[1]) << 8 | uint8_t(lean[2]) << 16 | uint32_t(uint8_t(lean[3])) << 24;
+    const OJson lh = OJson::parse(lean.substr(4, leanLen));
+    EXPECT_FALSE(lh.contains("cloud"));
+    for (const auto &b : lh["blobs"]) EXPECT_EQ(b["type"], "image/jpeg") << b["name"];
+    EXPECT_EQ(lh["blobs"].size(), 6u);
+    EXPECT_LT(lean.size() + 1000, m.size());
 }
 
 TEST(ViewerControls, FromSettingsTables) {

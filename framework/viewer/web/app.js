@@ -5,10 +5,11 @@
 
 const token = new URLSearchParams(location.search).get('token') || '';
 const $ = (id) => document.getElementById(id);
-// Read by the browser tests: what the page has received.
+// Read by the browser tests: what the page has received; drawn: the sequence number of
+// the frame each image panel shows.
 // showMs: from a frame's arrival until it was drawn, summed over the frames
 // received (bench/view_overhead.py reads it).
-window.binocle = { framesReceived: 0, lastHeader: null, lastError: '', state: null, replies: [], showMs: 0 };
+window.binocle = { framesReceived: 0, drawn: {}, lastHeader: null, lastError: '', state: null, replies: [], showMs: 0 };
 
 let ws = null;
 let colorScale = [];
@@ -195,7 +196,8 @@ const imageNames = ['left', 'right', 'disparity', 'top', 'front', 'side'];
 // ImageDecoder (WebCodecs) reads the frame's own buffer: no Blob, no object URL, no
 // round trip through the browser process (those cost more CPU than the decoding, measured
 // by bench/view_overhead.py). Where it is missing (a non-local origin, another browser),
-// createImageBitmap of a Blob.
+// createImageBitmap of a Blob. (One JPEG mosaic of the six images instead, decoded once,
+// cost the browser more, not less: measured, and left.)
 function decodeImage(bytes, type) {
   if (typeof ImageDecoder === 'function') {
     const decoder = new ImageDecoder({ data: bytes, type });
@@ -212,7 +214,7 @@ function drawImage(name, image, sequence) {
     c.height = h;
   }
   c.getContext('2d').drawImage(image, 0, 0);
-  c.dataset.sequence = sequence;
+  window.binocle.drawn[name] = sequence; // not a DOM attribute: no style work per frame
   image.close();
 }
 
@@ -237,23 +239,42 @@ function onFrame(buffer) {
       if (r.status === 'fulfilled') drawImage(names[i], r.value, header.sequence);
       else console.warn(`frame ${header.sequence}: image ${names[i]} not decoded: ${r.reason}`);
     });
-    // The 3D view is drawn again only here, when a new cloud has come (or on a drag).
+    // The 3D view is drawn again only here, when a new cloud has come (the server sends
+    // one at most --cloud-fps times a second) or on a drag.
     if (blob.cloud_xyz) {
       const xyz = new Float32Array(buffer.slice(blob.cloud_xyz.start, blob.cloud_xyz.start + blob.cloud_xyz.b.size));
       cloudView.setPoints(xyz, header.cloud.frame);
     }
     window.binocle.framesReceived += 1;
     window.binocle.lastHeader = header;
-    setText($('frame-counter'), String(header.frames_processed));
-    setText($('sequence'), String(header.sequence));
-    setText($('frames-shown'), String(window.binocle.framesReceived));
-    setText($('fps'), header.pipeline_fps !== null ? `${header.pipeline_fps.toFixed(1)} fps` : '');
     drawScale(header.disparity_scale);
-    showFigures(header);
-    setText($('source-stats'), header.source_statistics || '(the source reports none)');
+    showText(header);
     window.binocle.showMs += performance.now() - arrived;
     send({ op: 'shown' });
   });
+}
+
+// The text (counters, figures, source statistics) changes at most twice a second, in a
+// frame's task: faster numbers cannot be read, and every change of the side panel costs
+// the browser a layout and a paint (measured by bench/view_overhead.py). The last frame's
+// text is shown anyway once frames stop coming (pause, end).
+const TEXT_INTERVAL_MS = 500;
+let textShownAt = -Infinity;
+let textTimer = null;
+function showText(header) {
+  clearTimeout(textTimer);
+  const due = textShownAt + TEXT_INTERVAL_MS - performance.now();
+  if (due > 0) {
+    textTimer = setTimeout(() => showText(header), due + 250);
+    return;
+  }
+  textShownAt = performance.now();
+  setText($('frame-counter'), String(header.frames_processed));
+  setText($('sequence'), String(header.sequence));
+  setText($('frames-shown'), String(window.binocle.framesReceived));
+  setText($('fps'), header.pipeline_fps !== null ? `${header.pipeline_fps.toFixed(1)} fps` : '');
+  showFigures(header);
+  setText($('source-stats'), header.source_statistics || '(the source reports none)');
 }
 
 // Changes the DOM only where the text changed: less for the browser to lay out and paint.
