@@ -8,7 +8,8 @@
 # machine (other users of a shared box included), in cores (1.0 = one core busy).
 #
 # usage: /usr/bin/python3 bench/view_overhead.py [--rig RIG] [--rounds 3] [--seconds 10]
-#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--page-without-cloud] [--swiftshader-compositing]
+#        [--set KEY=VALUE]... [--view-arg=--display-fps=5]... [--page-draws-nothing] [--page-without-cloud]
+#        [--page-script JS]... [--swiftshader-compositing]
 #        [--json FILE]
 #   BINOCLE_CLI (default build/bin/binocle), BINOCLE_PLUGIN_PATH (absolute) as for the CLI.
 # Run it inside scripts/netns-test.sh to keep everything on loopback.
@@ -39,6 +40,9 @@ parser.add_argument("--page-draws-nothing", action="store_true",
                          "(copy, encoding, sending) without the browser's rendering")
 parser.add_argument("--page-without-cloud", action="store_true",
                     help="the page draws everything but the 3D view: what the WebGL point view costs the browser")
+parser.add_argument("--page-script", action="append", default=[],
+                    help="JavaScript run in the page once it shows frames (e.g. 'showFigures = function () {};'): "
+                         "what one part of the page costs, by switching it off")
 parser.add_argument("--swiftshader-compositing", action="store_true",
                     help="Chromium composites the page through SwiftShader too (a testing-only path; by default it "
                          "composites in software, as Chrome without a usable GPU does; WebGL is on SwiftShader either way)")
@@ -86,6 +90,27 @@ def descendants(pid):
     return out
 
 
+def process_kind(pid):
+    """Chromium's process type (renderer, gpu-process, utility, ...; 'browser' for the main
+    one, 'chromedriver' for the driver), to say which part of the browser takes the CPU."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            # Chromium's children rewrite their title: one string, arguments joined by spaces.
+            argv = f.read().decode(errors="replace").replace("\0", " ").split()
+    except OSError:
+        return "ended"
+    if argv and argv[0].endswith("chromedriver"):
+        return "chromedriver"
+    for a in argv:
+        if a.startswith("--type="):
+            kind = a[len("--type="):]
+            if kind == "utility":
+                sub = [x for x in argv if x.startswith("--utility-sub-type=")]
+                kind += ":" + (sub[0].split(".")[-1] if sub else "?")
+            return kind
+    return "browser"
+
+
 def machine_busy():
     """(busy, total) jiffies of all CPUs."""
     with open("/proc/stat") as f:
@@ -113,16 +138,23 @@ def measure(with_browser):
                 driver.execute_script("onFrame = function () { window.binocle.framesReceived += 1; send({op: 'shown'}); };")
             if args.page_without_cloud:  # the 3D view keeps its first cloud
                 driver.execute_script("cloudView.setPoints = function () {};")
+            for script in args.page_script:
+                driver.execute_script(script)
         time.sleep(args.warmup)
         browser = descendants(driver.service.process.pid) if driver else []
         n0, t0 = frames(port, token)
         v0, b0, m0 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
+        kinds = {pid: process_kind(pid) for pid in browser}
+        k0 = {pid: cpu_seconds([pid]) for pid in browser}
         page = "return [window.binocle.framesReceived, window.binocle.showMs]"
         s0, ms0 = driver.execute_script(page) if driver else (0, 0)
         time.sleep(args.seconds)
         n1, t1 = frames(port, token)
         v1, b1, m1 = cpu_seconds([view.pid]), cpu_seconds(browser), machine_busy()
         s1, ms1 = driver.execute_script(page) if driver else (0, 0)
+        by_kind = {}
+        for pid in browser:
+            by_kind[kinds[pid]] = by_kind.get(kinds[pid], 0.0) + cpu_seconds([pid]) - k0[pid]
         shown = s1 - s0
         load = os.getloadavg()[0]
     finally:
@@ -134,7 +166,8 @@ def measure(with_browser):
     cores = os.cpu_count()
     busy = cores * (m1[0] - m0[0]) / max(1, m1[1] - m0[1])
     return {"pipeline_fps": (n1 - n0) / dt, "page_fps": shown / dt, "view_cores": (v1 - v0) / dt,
-            "browser_cores": (b1 - b0) / dt, "page_show_ms": (ms1 - ms0) / shown if shown else 0, "machine_busy_cores": busy,
+            "browser_cores": (b1 - b0) / dt,
+            "browser_cores_by_process": {k: round(v / dt, 3) for k, v in sorted(by_kind.items())} if driver else {}, "page_show_ms": (ms1 - ms0) / shown if shown else 0, "machine_busy_cores": busy,
             "others_cores": max(0.0, busy - (v1 - v0) / dt - (b1 - b0) / dt), "load_1min": load}
 
 
@@ -157,7 +190,7 @@ def med(which, key):
 
 ratios = [x["with"]["pipeline_fps"] / x["without"]["pipeline_fps"] for x in rounds if x["without"]["pipeline_fps"] > 0]
 result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_draws_nothing": args.page_draws_nothing,
-          "page_without_cloud": args.page_without_cloud,
+          "page_without_cloud": args.page_without_cloud, "page_script": args.page_script,
           "swiftshader_compositing": args.swiftshader_compositing, "rounds": args.rounds, "window_s": args.seconds,
           "cores": os.cpu_count(),
           "fps_without_browser": round(med("without", "pipeline_fps"), 2),
@@ -171,6 +204,8 @@ result = {"rig": os.path.basename(args.rig), "view_args": args.view_arg, "page_d
           "browser_cpu_ms_per_page_frame": round(1000 * med("with", "browser_cores") / med("with", "page_fps"), 1)
           if med("with", "page_fps") > 0 else None,
           "page_show_ms": round(med("with", "page_show_ms"), 1),
+          "browser_cores_by_process": {k: round(statistics.median(x["with"]["browser_cores_by_process"].get(k, 0) for x in rounds), 3)
+                                       for k in rounds[0]["with"]["browser_cores_by_process"]},
           "others_cores_without": round(med("without", "others_cores"), 2),
           "others_cores_with": round(med("with", "others_cores"), 2)}
 print(json.dumps(result))
