@@ -8,6 +8,7 @@
 #include "replay_files.hpp"
 #include "replay_metadata.hpp"
 
+#include "common/frame_pacer.hpp"
 #include "input/image_file.hpp"
 #include "input/text.hpp"
 
@@ -20,7 +21,6 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -29,7 +29,6 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -38,6 +37,7 @@ namespace fs = std::filesystem;
 namespace binocle::replay {
 namespace {
 
+using plugins::FramePacer;
 using sdk::Error;
 
 // ---- Settings ----------------------------------------------------------------------------
@@ -628,7 +628,7 @@ public:
 
     void start() override {
         started_ = true;
-        due_ = std::chrono::steady_clock::now();
+        pacer_.start(periodNs_, "replay", "rate_hz " + std::to_string(settings_.rateHz));
     }
 
     void stop() override { started_ = false; }
@@ -643,7 +643,8 @@ public:
                 next_ = 0;
                 ++pass_;
             }
-            waitUntilDue(timeout_ms);
+            // rate_hz > 0: frames are due one period apart.
+            if (settings_.rateHz > 0) pacer_.wait(timeout_ms);
             auto pixels = std::make_shared<Pixels>();
             const FrameFiles &files = plan_.frames[next_];
             if (!decode(files, *pixels)) continue; // a cut-short last frame was dropped
@@ -666,24 +667,6 @@ public:
     }
 
 private:
-    // rate_hz > 0: frames are due one period apart; a late consumer gets the next frame
-    // at once but no burst of frames to catch up.
-    void waitUntilDue(int32_t timeout_ms) {
-        if (settings_.rateHz <= 0) return;
-        using namespace std::chrono;
-        const auto now = steady_clock::now();
-        if (due_ > now) {
-            if (timeout_ms >= 0 && due_ - now > milliseconds(timeout_ms)) {
-                std::this_thread::sleep_for(milliseconds(timeout_ms));
-                throw Error(BINOCLE_ERR_TIMEOUT, "replay: next frame due after the timeout of " +
-                                                     std::to_string(timeout_ms) + " ms (rate_hz " +
-                                                     std::to_string(settings_.rateHz) + ")");
-            }
-            std::this_thread::sleep_until(due_);
-        }
-        due_ = std::max(due_, steady_clock::now() - nanoseconds(periodNs_)) + nanoseconds(periodNs_);
-    }
-
     // Decodes the pair and its ground truth; false when the frame was the cut-short end
     // of a recording and has been dropped.
     bool decode(const FrameFiles &files, Pixels &px) {
@@ -767,7 +750,7 @@ private:
     int64_t periodNs_ = 0;
     int64_t passNs_ = 0;
     bool started_ = false;
-    std::chrono::steady_clock::time_point due_{};
+    FramePacer pacer_;
     size_t next_ = 0;        // index in plan_.frames of the next frame
     uint64_t sequence_ = 0;  // of the next frame delivered
     uint64_t delivered_ = 0;

@@ -8,6 +8,7 @@
 #include "rig.hpp"
 #include "scene.hpp"
 
+#include "common/frame_pacer.hpp"
 #include "common/param_check.hpp"
 
 #include <binocle/plugin.hpp>
@@ -18,7 +19,6 @@
 #include <memory>
 #include <optional>
 #include <sstream>
-#include <thread>
 
 namespace binocle::plugins {
 
@@ -163,12 +163,12 @@ public:
         }
     }
 
-    void start() override { due_ = std::chrono::steady_clock::now(); }
+    void start() override { pacer_.start(periodNs_, "sim", "pace at frame_rate_hz " + std::to_string(1e9 / periodNs_)); }
 
     std::unique_ptr<sdk::Frame> grab(int32_t timeout_ms) override {
         if (frames_ > 0 && next_ >= static_cast<uint64_t>(frames_))
             throw Error(BINOCLE_ERR_END_OF_STREAM, "sim: all " + std::to_string(frames_) + " frames delivered");
-        if (pace_) waitUntilDue(timeout_ms);
+        if (pace_) pacer_.wait(timeout_ms);
         const auto started = std::chrono::steady_clock::now();
         const uint64_t index = next_++;
         sim::RigPose pose;
@@ -218,22 +218,6 @@ public:
     }
 
 private:
-    // pace: frames are due one period apart, from start(); a late consumer gets the next
-    // frame at once but no burst of frames to catch up (as replay's rate_hz).
-    void waitUntilDue(int32_t timeout_ms) {
-        using namespace std::chrono;
-        const auto now = steady_clock::now();
-        if (due_ > now) {
-            if (timeout_ms >= 0 && due_ - now > milliseconds(timeout_ms)) {
-                std::this_thread::sleep_for(milliseconds(timeout_ms));
-                throw Error(BINOCLE_ERR_TIMEOUT, "sim: next frame due after the timeout of " + std::to_string(timeout_ms) +
-                                                     " ms (pace at frame_rate_hz " + std::to_string(1e9 / periodNs_) + ")");
-            }
-            std::this_thread::sleep_until(due_);
-        }
-        due_ = std::max(due_, steady_clock::now() - nanoseconds(periodNs_)) + nanoseconds(periodNs_);
-    }
-
     static binocle_image view(const cv::Mat &m, int32_t format) {
         return sdk::makeImage(m.cols, m.rows, format, const_cast<uint8_t *>(m.data), static_cast<int32_t>(m.step));
     }
@@ -243,7 +227,7 @@ private:
     sim::Scene scene_;
     std::optional<sim::BoardSettings> board_;
     bool pace_ = false;
-    std::chrono::steady_clock::time_point due_ = std::chrono::steady_clock::now();
+    FramePacer pacer_; // pace: frames one period apart from start(), as replay's rate_hz
     int64_t frames_ = 1;
     double forward_ = 0, lateral_ = 0;
     int64_t periodNs_ = 0;
