@@ -227,8 +227,10 @@ struct RecordingWriter::Pool {
                 if (failure.empty()) {
                     rows += static_cast<int64_t>(batch.size());
                     ++stats.syncs;
-                } else if (error.empty()) {
-                    error = failure;
+                } else {
+                    if (error.empty()) error = failure;
+                    // Their rows never made it: their images are orphans too.
+                    inOrder.insert(inOrder.begin(), batch.begin(), batch.end());
                 }
             }
             if (!error.empty()) {
