@@ -158,12 +158,16 @@ void Engine::matchStripe(int index, int y0, int y1) {
             }
             const bool first = y == yFirst;
             const uint8_t *greyPrev = first ? nullptr : greyLeft_.ptr<uint8_t>(y - step);
+            RowPaths rp{};
+            rp.count = static_cast<int>(dxs.size());
             for (size_t i = 0; i < dxs.size(); ++i) {
-                kernels_.pathRow(s.cost.data(), width_, paddedDisp_, first ? nullptr : pathL(i, parity ^ 1),
-                                 pathMin(i, parity ^ 1), dxs[i], greyLeft_.ptr<uint8_t>(y), greyPrev, pp,
-                                 pathL(i, parity), pathMin(i, parity), sum, init);
-                init = false;
+                rp.dx[i] = dxs[i];
+                rp.prevL[i] = first ? nullptr : pathL(i, parity ^ 1);
+                rp.prevMin[i] = pathMin(i, parity ^ 1);
+                rp.curL[i] = pathL(i, parity);
+                rp.curMin[i] = pathMin(i, parity);
             }
+            kernels_.pathRow(s.cost.data(), width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, init);
             if (own && (down != twoPass_)) finishRow(s, sum, y);
             parity ^= 1;
             if (y == yLast) break;

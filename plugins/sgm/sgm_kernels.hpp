@@ -48,14 +48,23 @@ struct PathParams {
     const uint8_t *p2Lut; // penalty for larger changes, by |intensity step| (256 entries, >= p1)
 };
 
-// One row of a path whose predecessor lies in the previous row (vertical or diagonal):
-// pixel x follows pixel x + dx of prevL (dx in -1, 0, 1); a pixel without predecessor
-// (prevL NULL, or x + dx outside) starts the path. grey/greyPrev: the intensities of this
-// row and of the previous one, for the penalty P2. Writes curL and curMin, and adds the
+// One row of up to kMaxRowPaths paths whose predecessors lie in the previous row
+// (vertical or diagonal), all added to sum in one pass. Path i: pixel x follows pixel
+// x + dx[i] of prevL[i] (dx in -1, 0, 1); a pixel without predecessor (prevL[i] NULL, or
+// x + dx[i] outside) starts the path. grey/greyPrev: the intensities of this row and of
+// the previous one, for the penalty P2. Writes curL[i] and curMin[i], and adds the
 // row's path costs to sum (or stores them when initSum).
-using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *prevL, const uint8_t *prevMin,
-                           int dx, const uint8_t *grey, const uint8_t *greyPrev, const PathParams &pp, uint8_t *curL,
-                           uint8_t *curMin, uint16_t *sum, bool initSum);
+constexpr int kMaxRowPaths = 3;
+struct RowPaths {
+    int count;
+    int dx[kMaxRowPaths];
+    const uint8_t *prevL[kMaxRowPaths];
+    const uint8_t *prevMin[kMaxRowPaths];
+    uint8_t *curL[kMaxRowPaths];
+    uint8_t *curMin[kMaxRowPaths];
+};
+using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                           const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum);
 
 // One row of both horizontal paths, left to right and right to left, added to sum (or
 // stored, when initSum); scratch: 2 * pathStride(paddedDisp) bytes.

@@ -68,20 +68,20 @@ const uint8_t *freshPath() {
     return fresh.data + 1;
 }
 
-void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const uint8_t *prevL, const uint8_t *prevMin, int dx,
-                   const uint8_t *grey, const uint8_t *greyPrev, const PathParams &pp, uint8_t *curL, uint8_t *curMin,
-                   uint16_t *sum, bool initSum) {
+void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                   const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
     const int stride = pathStride(paddedDisp);
-    for (int x = 0; x < width; ++x) {
-        const int xp = x + dx;
-        const bool has = prevL && xp >= 0 && xp < width;
-        const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
-        const int minPrev = has ? prevMin[xp] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
-        curMin[x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2,
-                             curL + static_cast<size_t>(x) * stride + 1, sum + static_cast<size_t>(x) * paddedDisp,
-                             paddedDisp, initSum);
-    }
+    for (int i = 0; i < paths.count; ++i)
+        for (int x = 0; x < width; ++x) {
+            const int xp = x + paths.dx[i];
+            const bool has = paths.prevL[i] && xp >= 0 && xp < width;
+            const uint8_t *prev = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+            const int minPrev = has ? paths.prevMin[i][xp] : 255;
+            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            paths.curMin[i][x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2,
+                                          paths.curL[i] + static_cast<size_t>(x) * stride + 1,
+                                          sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum && i == 0);
+        }
 }
 
 void horizontalPath(const uint8_t *cost, int width, int paddedDisp, bool forward, const uint8_t *grey,

@@ -130,32 +130,6 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
 }
 
 // ---- paths ----------------------------------------------------------------------------
-// One pixel of one path (see pathStep in the scalar reference); returns min L.
-inline uint8_t pathStep(const uint8_t *cost, const uint8_t *prev, int minPrev, const v_uint8 &p1, int p2, uint8_t *out,
-                        uint16_t *sum, int paddedDisp, bool initSum) {
-    const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-    const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
-    v_uint8 least = vx_setall_u8(255);
-    for (int d = 0; d < paddedDisp; d += kLanes8) {
-        // + and - on 8- and 16-bit lanes saturate in OpenCV's universal intrinsics.
-        const v_uint8 steps = v_min(vx_load(prev + d - 1), vx_load(prev + d + 1)) + p1;
-        const v_uint8 t = v_min(v_min(vx_load(prev + d), steps), jump);
-        const v_uint8 l = vx_load(cost + d) + (t - base);
-        v_store(out + d, l);
-        least = v_min(least, l);
-        v_uint16 lo, hi;
-        v_expand(l, lo, hi);
-        if (initSum) {
-            v_store(sum + d, lo);
-            v_store(sum + d + kLanes16, hi);
-        } else {
-            v_store(sum + d, vx_load(sum + d) + lo);
-            v_store(sum + d + kLanes16, vx_load(sum + d + kLanes16) + hi);
-        }
-    }
-    return v_reduce_min(least);
-}
-
 struct Fresh {
     uint8_t data[kDispAlign * 9 + 2];
     Fresh() {
@@ -167,20 +141,52 @@ const uint8_t *freshPath() {
     return fresh.data + 1;
 }
 
-void pathRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *prevL, const uint8_t *prevMin, int dx,
-             const uint8_t *grey, const uint8_t *greyPrev, const PathParams &pp, uint8_t *curL, uint8_t *curMin,
-             uint16_t *sum, bool initSum) {
+// L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + P1, min L(q) + P2) - min L(q) for the
+// paths of a row side by side, pixel by pixel, so that the 16-bit sums are read and
+// written once per pixel whatever the number of paths.
+void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
     const int stride = pathStride(paddedDisp);
+    const int n = paths.count;
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     for (int x = 0; x < width; ++x) {
-        const int xp = x + dx;
-        const bool has = prevL && xp >= 0 && xp < width;
-        const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
-        const int minPrev = has ? prevMin[xp] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
-        curMin[x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, p1, p2,
-                             curL + static_cast<size_t>(x) * stride + 1, sum + static_cast<size_t>(x) * paddedDisp,
-                             paddedDisp, initSum);
+        const uint8_t *prev[kMaxRowPaths];
+        uint8_t *out[kMaxRowPaths];
+        v_uint8 base[kMaxRowPaths], jump[kMaxRowPaths], least[kMaxRowPaths];
+        for (int i = 0; i < n; ++i) {
+            const int xp = x + paths.dx[i];
+            const bool has = paths.prevL[i] && xp >= 0 && xp < width;
+            prev[i] = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+            const int minPrev = has ? paths.prevMin[i][xp] : 255;
+            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            base[i] = vx_setall_u8(static_cast<uint8_t>(minPrev));
+            jump[i] = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            least[i] = vx_setall_u8(255);
+            out[i] = paths.curL[i] + static_cast<size_t>(x) * stride + 1;
+        }
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const v_uint8 c = vx_load(c0 + d);
+            v_uint16 lo = initSum ? vx_setzero_u16() : vx_load(s0 + d);
+            v_uint16 hi = initSum ? vx_setzero_u16() : vx_load(s0 + d + kLanes16);
+            for (int i = 0; i < n; ++i) {
+                // + and - on 8- and 16-bit lanes saturate in OpenCV's universal intrinsics.
+                const uint8_t *q = prev[i] + d;
+                const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+                const v_uint8 t = v_min(v_min(vx_load(q), steps), jump[i]);
+                const v_uint8 l = c + (t - base[i]);
+                v_store(out[i] + d, l);
+                least[i] = v_min(least[i], l);
+                v_uint16 l0, l1;
+                v_expand(l, l0, l1);
+                lo += l0;
+                hi += l1;
+            }
+            v_store(s0 + d, lo);
+            v_store(s0 + d + kLanes16, hi);
+        }
+        for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
     }
 }
 

@@ -105,24 +105,38 @@ PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2) 
 }
 
 TEST_P(SimdKernels, PathsEqualTheReference) {
+    // Path sets as the engine runs them: one vertical, three from above, and others.
+    const std::vector<std::vector<int>> sets = {{0}, {-1, 0, 1}, {1}, {-1}, {1, -1}};
     for (int width : kWidths)
         for (int numDisp : {16, 64, 96, 256})
-            for (int dx : {-1, 0, 1})
+            for (const std::vector<int> &dxs : sets)
                 for (bool first : {false, true})
                     for (bool init : {false, true}) {
-                        PathCase c = pathCase(rng, width, numDisp, 1 + static_cast<int>(rng() % 20), 60 + static_cast<int>(rng() % 130));
-                        const sgm::PathParams pp{c.lut[255], c.lut.data()};
-                        const size_t n = static_cast<size_t>(width) * sgm::pathStride(c.dp);
-                        std::vector<uint8_t> la(n, sgm::kCostInvalid), lb(n, sgm::kCostInvalid);
-                        std::vector<uint8_t> ma(static_cast<size_t>(width)), mb(static_cast<size_t>(width));
+                        const int n = static_cast<int>(dxs.size());
+                        std::vector<PathCase> cases;
+                        const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
+                        for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2));
+                        const PathCase &c = cases[0];
+                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const size_t rowBytes = static_cast<size_t>(width) * sgm::pathStride(c.dp);
+                        std::vector<std::vector<uint8_t>> la(3, std::vector<uint8_t>(rowBytes, sgm::kCostInvalid)), lb = la;
+                        std::vector<std::vector<uint8_t>> ma(3, std::vector<uint8_t>(static_cast<size_t>(width))), mb = ma;
+                        sgm::RowPaths ra{}, rb{};
+                        ra.count = rb.count = n;
+                        for (int i = 0; i < n; ++i) {
+                            ra.dx[i] = rb.dx[i] = dxs[static_cast<size_t>(i)];
+                            ra.prevL[i] = rb.prevL[i] = first ? nullptr : cases[static_cast<size_t>(i)].prevL.data();
+                            ra.prevMin[i] = rb.prevMin[i] = cases[static_cast<size_t>(i)].prevMin.data();
+                            ra.curL[i] = la[static_cast<size_t>(i)].data();
+                            rb.curL[i] = lb[static_cast<size_t>(i)].data();
+                            ra.curMin[i] = ma[static_cast<size_t>(i)].data();
+                            rb.curMin[i] = mb[static_cast<size_t>(i)].data();
+                        }
                         std::vector<uint16_t> sa = c.sum, sb = c.sum;
-                        const uint8_t *prev = first ? nullptr : c.prevL.data();
-                        ref().pathRow(c.cost.data(), width, c.dp, prev, c.prevMin.data(), dx, c.grey.data(), c.greyPrev.data(),
-                                      pp, la.data(), ma.data(), sa.data(), init);
-                        simd().pathRow(c.cost.data(), width, c.dp, prev, c.prevMin.data(), dx, c.grey.data(),
-                                       c.greyPrev.data(), pp, lb.data(), mb.data(), sb.data(), init);
+                        ref().pathRow(c.cost.data(), width, c.dp, ra, c.grey.data(), c.greyPrev.data(), pp, sa.data(), init);
+                        simd().pathRow(c.cost.data(), width, c.dp, rb, c.grey.data(), c.greyPrev.data(), pp, sb.data(), init);
                         const std::string what = "width " + std::to_string(width) + ", num_disparities " +
-                                                 std::to_string(numDisp) + ", dx " + std::to_string(dx);
+                                                 std::to_string(numDisp) + ", paths " + std::to_string(n);
                         ASSERT_EQ(la, lb) << what;
                         ASSERT_EQ(ma, mb) << what;
                         ASSERT_EQ(sa, sb) << what;
