@@ -37,7 +37,7 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
 double Engine::workingBytes(int width, int height) const {
     const double w = width, h = height, dp = paddedDisp_, ds = pathStride(paddedDisp_);
     const double rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
-    const double volume = twoPass_ ? w * h * dp * 2 : 0;
+    const double volume = twoPass_ ? w * h * dp * 3 : 0; // 16-bit sums and 8-bit costs
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
     const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 2 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
@@ -52,7 +52,7 @@ void Engine::prepare(int width, int height) {
             "sgm: paths " + std::to_string(settings_.paths) + " on a " + std::to_string(width) + "x" +
             std::to_string(height) + " pair with num_disparities " + std::to_string(settings_.numDisparities) +
             " needs about " + mebibytes(need) + " MiB of working memory" +
-            (twoPass_ ? " (a volume of width x height x num_disparities 16-bit sums)" : "") +
+            (twoPass_ ? " (volumes of width x height x num_disparities costs and sums: 3 bytes each)" : "") +
             "; expected at most max_memory_mb = " + mebibytes(settings_.maxMemoryBytes) + ": use " +
             (twoPass_ ? "paths 5 (no volume), " : "") + "fewer disparities, smaller images or raise max_memory_mb");
     width_ = width;
@@ -62,6 +62,7 @@ void Engine::prepare(int width, int height) {
     censusLeft_.assign(w * h, 0);
     censusRight_.assign(w * h, 0);
     volume_.assign(twoPass_ ? w * h * dp : 0, 0);
+    costVolume_.assign(twoPass_ ? w * h * dp : 0, 0);
     stripes_.assign(static_cast<size_t>(std::clamp(settings_.stripes, 1, height)), Stripe{});
     for (Stripe &s : stripes_) {
         s.cost.assign(w * dp, kCostInvalid);
@@ -96,10 +97,14 @@ void Engine::censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint6
     });
 }
 
-void Engine::costRow(Stripe &s, int y) {
+const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
     const size_t at = static_cast<size_t>(y) * width_;
+    uint8_t *volumeRow = twoPass_ && own ? costVolume_.data() + at * paddedDisp_ : nullptr;
+    if (volumeRow && !down) return volumeRow; // computed by this stripe's pass down
+    uint8_t *out = volumeRow ? volumeRow : s.cost.data();
     kernels_.costRow(censusLeft_.data() + at, censusRight_.data() + at, width_, settings_.minDisparity,
-                     settings_.numDisparities, paddedDisp_, s.costScratch.data(), s.cost.data());
+                     settings_.numDisparities, paddedDisp_, s.costScratch.data(), out);
+    return out;
 }
 
 // Winner takes all on one row of sums, then the left-right check: the right image's
@@ -148,11 +153,11 @@ void Engine::matchStripe(int index, int y0, int y1) {
         int parity = 0;
         for (int y = yFirst;; y += step) {
             const bool own = y >= y0 && y < y1;
-            costRow(s, y);
+            const uint8_t *cost = costRow(s, y, own, down);
             uint16_t *sum = own && twoPass_ ? volumeRow(y) : s.scratchSum.data();
             bool init = !own || down; // the pass up adds to the pass down's sums
             if (own && down) {
-                kernels_.horizontalRow(s.cost.data(), width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
                                        s.horizontal.data(), sum, true);
                 init = false;
             }
@@ -167,7 +172,7 @@ void Engine::matchStripe(int index, int y0, int y1) {
                 rp.curL[i] = pathL(i, parity);
                 rp.curMin[i] = pathMin(i, parity);
             }
-            kernels_.pathRow(s.cost.data(), width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, init);
+            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, init);
             if (own && (down != twoPass_)) finishRow(s, sum, y);
             parity ^= 1;
             if (y == yLast) break;

@@ -17,14 +17,14 @@ struct Settings {
     int numDisparities = 64;
     int censusWidth = 9;
     int censusHeight = 7;
-    int paths = 8;              // 4 (horizontal + vertical), 5 (one pass), 8
+    int paths = 4;              // 4 (horizontal + vertical), 5 (one pass), 8
     int p1 = 10;
     int p2 = 120;
-    int p2IntensityStep = 0;    // 0: P2 constant; else P2 * s / (s + |intensity step|), >= p1
-    int uniquenessPercent = 5;
+    int p2IntensityStep = 30;   // 0: P2 constant; else P2 * s / (s + |intensity step|), >= p1
+    int uniquenessPercent = 8;
     int disp12MaxDiff = 1;      // -1: no left-right check
     bool subpixel = true;
-    int medianPx = 3;           // 1: none
+    int medianPx = 5;           // 1: none
     int stripes = 4;
     double maxMemoryBytes = 2048.0 * 1048576.0;
 };
@@ -62,7 +62,9 @@ private:
     void prepare(int width, int height);
     void censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census);
     void matchStripe(int stripe, int y0, int y1);
-    void costRow(Stripe &s, int y);
+    // The costs of row y: computed into the stripe's row (or into the cost volume, for a
+    // row of the stripe's own in the pass down), or read back from the volume.
+    const uint8_t *costRow(Stripe &s, int y, bool own, bool down);
     void finishRow(Stripe &s, const uint16_t *sum, int y);
     uint16_t *volumeRow(int y) { return volume_.data() + static_cast<size_t>(y) * width_ * paddedDisp_; }
 
@@ -74,7 +76,8 @@ private:
     uint8_t p2Lut_[256];
     cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_, filtered_;
     std::vector<uint64_t> censusLeft_, censusRight_;
-    std::vector<uint16_t> volume_;
+    std::vector<uint16_t> volume_;  // 4 and 8 paths: the pass down's sums
+    std::vector<uint8_t> costVolume_; // and its costs, which the pass up reads again
     std::vector<Stripe> stripes_;
     int allocations_ = 0;
 };
