@@ -20,13 +20,16 @@
 
 namespace sgm {
 
+// The helpers below are `static`: each file has its own copy, so the linker never hands
+// a baseline caller the copy compiled for AVX2 (sgm_kernels_avx2.cpp includes this too).
+
 // Disparity counts are padded to a multiple of this (the widest vector, AVX2's 32 bytes),
 // so that every table works on the same buffers.
 constexpr int kDispAlign = 32;
 constexpr uint8_t kCostInvalid = 255;
 
-inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
-inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
+static inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
+static inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
 
 // Census bits of one row. rows[j] points at image column 0 of the grey row y + j - ch/2 of
 // an image padded by cw/2 columns on each side (so rows[j][x + dx] is readable for
@@ -107,7 +110,7 @@ const Kernels &bestKernels();
 
 // The sub-pixel refinement shared by every table (scalar per pixel: no SIMD to compare).
 // Returns (minD + d) * 16 + the parabola's offset in 1/16 px, or 0 when that is <= 0.
-inline uint16_t refinedDisparity16(const uint16_t *s, int d, const WtaParams &wp) {
+static inline uint16_t refinedDisparity16(const uint16_t *s, int d, const WtaParams &wp) {
     int value = (wp.minDisparity + d) * 16;
     if (wp.subpixel && d > 0 && d < wp.numDisp - 1) {
         const int left = s[d - 1], right = s[d + 1], centre = s[d];
