@@ -2,6 +2,7 @@
 // sgm plugin, as built, through the plugin host: accuracy on a synthetic pair and on the
 // real aloe pair, settings refused with their reason, the ABI's invalid pixels, and the
 // same disparity whatever the instruction set.
+#include "../common/test_util.hpp"
 #include "plugin_fixtures.hpp"
 
 #include <gtest/gtest.h>
@@ -108,6 +109,17 @@ TEST(SgmPlugin, RefusesInputsTheAbiRulesOut) {
     binocle_image g16 = imageOf(grey, BINOCLE_PIXEL_GRAY16);
     EXPECT_EQ(m.compute(g16, g16, out), BINOCLE_ERR_INVALID_ARGUMENT);
     EXPECT_NE(m.lastError().find("left image is GRAY16: expected GRAY8, BGR8 or RGB8"), std::string::npos) << m.lastError();
+}
+
+// The rigs that ship with sgm run as written, from the command line.
+TEST(SgmPlugin, ItsRigsRun) {
+    TempDir out;
+    const CommandResult r = runCli("run " BINOCLE_SOURCE_DIR "/configs/rigs/sim-e1-sgm.yaml --frames 1 --quiet --out " + out.str());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(out.str("summary.json"));
+    const std::string summary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(summary.find("\"matcher\": \"sgm\""), std::string::npos) << summary;
+    EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
 }
 
 } // namespace
