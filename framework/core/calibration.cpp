@@ -55,6 +55,13 @@ void StereoCalibration::computeRectification() {
 
 namespace {
 
+// What validate() accepts beyond finiteness (calibration.hpp): a focal length of 0.01
+// (a field of view far beyond 180 degrees) to 1000 (0.06 degrees) times the image's larger
+// side; a baseline of 0.1 mm (below any stereo rig: a unit mistake or garbage) to
+// kMaxBaselineMm; a principal point within one image size of the image.
+constexpr double kFocalPerSide[2] = {0.01, 1000};
+constexpr double kMinBaselineMm = 0.1;
+
 std::string number(double v) {
     if (std::isnan(v)) return "nan"; // not "-nan": the sign of a NaN means nothing here
     std::ostringstream s;
@@ -151,12 +158,12 @@ void checkCameraMatrix(const cv::Mat &M, const char *key, cv::Size size, const s
     if (M.at<double>(1, 0) != 0 || M.at<double>(2, 0) != 0 || M.at<double>(2, 1) != 0 || M.at<double>(2, 2) != 1)
         throw Error(origin + ": calibration key '" + key + "': expected a camera matrix [fx 0 cx; 0 fy cy; 0 0 1]");
     const double side = std::max(size.width, size.height);
-    const double lo = StereoCalibration::kFocalPerSide[0] * side, hi = StereoCalibration::kFocalPerSide[1] * side;
+    const double lo = kFocalPerSide[0] * side, hi = kFocalPerSide[1] * side;
     for (const auto &[name, f] : {std::pair<const char *, double>{"fx", fx}, {"fy", fy}})
         if (f < lo || f > hi)
             throw Error(origin + ": calibration key '" + key + "': focal length " + name + " = " + number(f) +
                         " px; expected " + number(lo) + ".." + number(hi) + " px (" +
-                        number(StereoCalibration::kFocalPerSide[0]) + " to " + number(StereoCalibration::kFocalPerSide[1]) +
+                        number(kFocalPerSide[0]) + " to " + number(kFocalPerSide[1]) +
                         " times the image's larger side, " + number(side) + " px)");
     const double skew = M.at<double>(0, 1);
     if (std::abs(skew) > hi)

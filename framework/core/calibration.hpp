@@ -36,16 +36,11 @@ struct StereoCalibration {
     // Fills R1, R2, P1, P2, Q (cv::stereoRectify, CALIB_ZERO_DISPARITY, alpha 0).
     void computeRectification();
 
-    // Throws binocle::Error naming `origin`, the key, the value and what was expected
-    // unless every value is finite, M1 and M2 are camera matrices whose focal lengths are
-    // kFocalPerSide times the image's larger side and whose principal points lie within
-    // one image size of the image, R is a rotation and the baseline is kMinBaselineMm ..
-    // kMaxBaselineMm. fromYaml() calls it.
+    // Throws binocle::Error naming `origin` and the key unless M1, M2 are camera matrices
+    // with positive focal lengths, every value is finite, R is a rotation and the
+    // baseline is > 0 and <= kMaxBaselineMm. fromYaml() calls it.
     void validate(const std::string &origin) const;
-    static constexpr double kMinBaselineMm = 0.1; // below any stereo rig: a unit mistake or garbage
     static constexpr double kMaxBaselineMm = 1e6; // 1 km: a larger one is a unit mistake
-    // 0.01: a field of view far beyond 180 degrees; 1000: one of 0.06 degrees.
-    static constexpr double kFocalPerSide[2] = {0.01, 1000};
 
     // Parse FileStorage YAML text. `origin` names the file in errors. Throws binocle::Error
     // naming the origin, the key that is missing or malformed and, where it has one, its

@@ -1,5 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Image headers checked before decoding; truncated files refused.
+// Beyond image_file.hpp: PGM/PPM headers are read exactly as OpenCV's PxM decoder reads
+// them; decodeImage has libjpeg decode a JPEG's entropy-coded data and refuses on its
+// "Corrupt JPEG data" warnings, and refuses an image decoded to another size than the
+// header checked.
 #include "input/image_file.hpp"
 
 #include "input/numbers.hpp"

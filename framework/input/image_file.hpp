@@ -4,12 +4,10 @@
 // decoded into a partial image.
 //
 // Checked from the bytes themselves: PNG (IHDR size, every chunk inside the file, IEND
-// present), JPEG (SOF size, segments inside the file, EOI present; decodeImage also has
-// libjpeg decode the entropy-coded data and refuses on its "Corrupt JPEG data"
-// warnings), PFM and binary PGM/PPM (header read as OpenCV reads it, pixel data inside
-// the file), BMP (header, pixel data inside the file). decodeImage refuses an image that
-// decodes to another size than the header checked. Other formats (TIFF, WebP, ...) are
-// left to OpenCV, whose own pixel limit the `binocle` command lowers to kMaxImagePixels.
+// present), JPEG (SOF size, segments inside the file, EOI present), PFM and binary
+// PGM/PPM (header, pixel data inside the file), BMP (header, pixel data inside the
+// file). Other formats (TIFF, WebP, ...) are left to OpenCV, whose own pixel limit the
+// `binocle` command lowers to kMaxImagePixels.
 #pragma once
 
 #include <opencv2/core.hpp>

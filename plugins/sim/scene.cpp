@@ -25,6 +25,9 @@ namespace binocle::sim {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Primitives (boxes, spheres, ...) a scene may hold: every ray is tested against them, so
+// a 100000 x 100000 cube_matrix would never render; refused when read, with the key.
+constexpr int64_t kMaxPrimitives = 10000;
 
 // Reads typed values out of YAML nodes; every error names origin:line:column and the key.
 class Reader {
@@ -247,12 +250,12 @@ private:
     }
 
     // Refuses, before anything is built, an object of `count` primitives that would take
-    // the scene past Scene::kMaxPrimitives; `key` names the setting that asked for them.
+    // the scene past kMaxPrimitives; `key` names the setting that asked for them.
     void budget(const YAML::Node &at, const std::string &key, int64_t count, const std::string &what) const {
         const auto used = static_cast<int64_t>(scene_.primitives.size());
-        if (count > Scene::kMaxPrimitives - used)
+        if (count > kMaxPrimitives - used)
             r_.fail(at, what + ": " + key + " asks for " + std::to_string(count) + " primitives; a scene holds at most " +
-                            std::to_string(Scene::kMaxPrimitives) + " (" + std::to_string(used) + " already used)");
+                            std::to_string(kMaxPrimitives) + " (" + std::to_string(used) + " already used)");
     }
 
     // Per-face textures of a box: `texture` for all, then `faces: {front: ...}` overrides.

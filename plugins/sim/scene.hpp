@@ -73,9 +73,6 @@ struct Scene {
 
     // Ids in the gt_object_id plane: 0 = nothing (sky), 1 = ground, 2 + i = objects[i].
     static constexpr uint16_t kSkyId = 0, kGroundId = 1;
-    // Primitives (boxes, spheres, ...) a scene may hold: every ray is tested against them,
-    // so a 100000 x 100000 cube_matrix would never render; refused when read, with the key.
-    static constexpr int64_t kMaxPrimitives = 10000;
 
     // Parses a scene. `origin` names the text in errors (the file path); relative image
     // paths are resolved against `baseDir`.
