@@ -302,8 +302,8 @@ TEST(SimScene, PrimitiveCountIsBoundedBeforeBuilding) {
               "scene.yaml:2:5: object 'p': cols x rows = 100000 x 100000 asks for 10000000000 primitives; a scene "
               "holds at most 10000 (0 already used)");
     EXPECT_EQ(error("objects:\n  - {name: p, type: cube_matrix, cols: 100, rows: 99}\n"
-                    "  - {name: t, type: tree, crown_spheres: 99}\n"),
-              "scene.yaml:3:38: object 't': crown_spheres = 99 (+ trunk and core) asks for 101 primitives; a scene "
+                    "  - {name: t, type: tree, base_mm: [0, 9000, 0], crown_spheres: 99}\n"),
+              "scene.yaml:3:65: object 't': crown_spheres = 99 (+ trunk and core) asks for 101 primitives; a scene "
               "holds at most 10000 (9900 already used)");
     EXPECT_EQ(error("objects:\n  - {name: p, type: cube_matrix, cols: 100, rows: 100}\n"), "");
 }
