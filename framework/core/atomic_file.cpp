@@ -7,8 +7,10 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <unistd.h>
 
@@ -36,12 +38,26 @@ std::string readTextFile(const std::string &path, uintmax_t maxBytes) {
 
 namespace {
 
-std::string temporaryFor(const std::string &path) {
-    fs::path p(path);
-    return (p.parent_path() / (".tmp-" + std::to_string(::getpid()) + "-" + p.filename().string())).string();
+// Creates "<dir>/.tmp-<random>-<name>" that did not exist: O_CREAT|O_EXCL never opens a
+// file or a symbolic link planted there (O_NOFOLLOW says so twice), and the random part
+// leaves nothing to plant in advance. Returns the open descriptor.
+int createTemporary(const std::string &path, std::string &tmp) {
+    const fs::path p(path);
+    static thread_local std::mt19937_64 random{std::random_device{}()};
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        char suffix[17];
+        std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(random()));
+        tmp = (p.parent_path() / (".tmp-" + std::string(suffix) + "-" + p.filename().string())).string();
+        const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd >= 0) return fd;
+        if (errno != EEXIST) throw Error("cannot write " + path + ": " + std::strerror(errno));
+    }
+    throw Error("cannot write " + path + ": no free temporary name beside it");
 }
 
 void commit(const std::string &tmp, const std::string &path) {
+    // rename() replaces `path` itself, even when it is a symbolic link: it writes through
+    // nothing planted there.
     std::error_code ec;
     fs::rename(tmp, path, ec);
     if (ec) {
@@ -53,27 +69,23 @@ void commit(const std::string &tmp, const std::string &path) {
 } // namespace
 
 void writeFileAtomic(const std::string &path, const std::string &bytes) {
-    writeFileAtomicWith(path, [&](const std::string &tmp) {
-        FILE *f = std::fopen(tmp.c_str(), "wb");
-        if (!f) throw Error("cannot write " + path + ": " + std::strerror(errno));
-        const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 &&
-                        ::fsync(::fileno(f)) == 0;
-        const int err = errno;
-        std::fclose(f);
-        if (!ok) throw Error("cannot write " + path + ": " + std::strerror(err));
-    });
-}
-
-void writeFileAtomicWith(const std::string &path, const std::function<void(const std::string &tmp)> &write) {
-    const std::string tmp = temporaryFor(path);
-    try {
-        write(tmp);
-    } catch (...) {
+    std::string tmp;
+    const int fd = createTemporary(path, tmp);
+    size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        done += static_cast<size_t>(n);
+    }
+    const bool ok = done == bytes.size() && ::fsync(fd) == 0;
+    const int err = errno;
+    ::close(fd);
+    if (!ok) {
         std::error_code ec;
         fs::remove(tmp, ec);
-        throw;
+        throw Error("cannot write " + path + ": " + std::strerror(err));
     }
-    if (!fs::exists(tmp)) throw Error("cannot write " + path + ": the writer produced no file");
     commit(tmp, path);
 }
 

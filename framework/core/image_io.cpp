@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -17,15 +18,18 @@
 namespace binocle {
 
 void writeImage(const std::string &path, const cv::Mat &image) {
-    writeFileAtomicWith(path, [&](const std::string &tmp) {
-        bool ok = false;
-        try {
-            ok = cv::imwrite(tmp, image);
-        } catch (const cv::Exception &e) {
-            throw Error("cannot write image " + path + ": " + e.err);
-        }
-        if (!ok) throw Error("cannot write image " + path);
-    });
+    // Encoded in memory, then written through writeFileAtomic's own temporary (never a
+    // name handed to OpenCV, which would open whatever is there).
+    const std::string ext = std::filesystem::path(path).extension().string();
+    std::vector<uchar> bytes;
+    bool ok = false;
+    try {
+        ok = cv::imencode(ext.empty() ? ".png" : ext, image, bytes);
+    } catch (const cv::Exception &e) {
+        throw Error("cannot write image " + path + ": " + e.err);
+    }
+    if (!ok) throw Error("cannot write image " + path);
+    writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
 void writeDisparityPng16(const std::string &path, const cv::Mat &disparity) {
