@@ -120,11 +120,11 @@ TEST(ViewerCommand, ShapesAndSizes) {
         }
     };
     EXPECT_NE(refused(std::string(kMaxCommandBytes + 1, ' ')).find("at most"), std::string::npos);
-    EXPECT_NE(refused(std::string(100000, '[')).find("flat"), std::string::npos);
+    EXPECT_NE(refused(std::string(1000, '[')).find("flat"), std::string::npos);
     EXPECT_NE(refused(R"({"op":"set","key":"matcher.x","value":")" + std::string(kMaxValueBytes + 1, 'x') + "\"}").find("at most"),
               std::string::npos);
     EXPECT_NE(refused(R"({"op":"set","key":"matcher.x","value":"a\u0000b"})").find("NUL"), std::string::npos);
-    EXPECT_NE(refused(R"({"op":"set","key":"../x","value":"1"})").find("character"), std::string::npos);
+    EXPECT_NE(refused(R"({"op":"set","key":"matcher/x","value":"1"})").find("character"), std::string::npos);
     EXPECT_NE(refused(R"({"op":"set","key":"matcher..x","value":"1"})").find("empty part"), std::string::npos);
     EXPECT_NE(refused(R"({"op":"set","key":"matcher.x"})").find("needs"), std::string::npos);
     EXPECT_NE(refused(R"({"op":"rm -rf"})").find("unknown command"), std::string::npos);
@@ -322,6 +322,12 @@ TEST(ViewerServerGuard, OversizedWebSocketMessageClosesThatSocketOnly) {
     Ws big(server.port()), other(server.port());
     ASSERT_TRUE(eventually([&] { return server.browsers() == 2; }));
     big.ws.write(net::buffer(std::string(kMaxCommandBytes + 1, 'x')));
+    // The server closes with 1009 (too big); reading answers its close frame.
+    boost::beast::flat_buffer b;
+    boost::system::error_code ec;
+    while (!ec) big.ws.read(b, ec);
+    EXPECT_EQ(ec, websocket::error::closed);
+    EXPECT_EQ(big.ws.reason().code, websocket::close_code::too_big);
     EXPECT_TRUE(eventually([&] { return server.browsers() == 1; }));
     EXPECT_EQ(commands, 0);
     other.ws.write(net::buffer(std::string(R"({"op":"pause"})")));
