@@ -15,6 +15,11 @@ build_dir="${BINOCLE_BUILD_DIR:-build}"
 out="${BINOCLE_DEMO_OUT:-out/demo}"
 binocle="$build_dir/bin/binocle"
 "$binocle" plugins
+# A second run replaces the demo's own folders of the first (the commands refuse, or
+# would mix, a folder that already holds results).
+for d in e1 design-6m design-12m; do
+  rm -rf -- "${out:?}/$d"
+done
 # The main job: experiment E1 of docs/method.md on the simulated Videre-like head
 # (nothing to download), then the design question it answers, for 6 m and 12 m.
 "$binocle" experiment configs/experiments/e1.yaml --out "$out/e1"

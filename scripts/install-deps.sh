@@ -6,7 +6,8 @@
 #   bash scripts/install-deps.sh test   that, plus the test tools (the test command); the default
 #
 # The groups are apart so that a user who wants to see Binocle work does not wait for a
-# browser, a batch scheduler and a fuzzer (about 700 MB) that only the tests use.
+# browser, a batch scheduler, a second compiler and sample data (several hundred MB)
+# that only the tests use.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
