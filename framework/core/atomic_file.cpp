@@ -4,11 +4,12 @@
 
 #include "core/error.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
+#include <fcntl.h>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -38,26 +39,27 @@ std::string readTextFile(const std::string &path, uintmax_t maxBytes) {
 
 namespace {
 
-// Creates "<dir>/.tmp-<random>-<name>" that did not exist: O_CREAT|O_EXCL never opens a
-// file or a symbolic link planted there (O_NOFOLLOW says so twice), and the random part
-// leaves nothing to plant in advance. Returns the open descriptor.
+// A new, empty temporary beside `path`: ".tmp-<pid>-<random>-<file name>" (the extension
+// kept for writers that choose the format by it), created with O_EXCL | O_NOFOLLOW so that
+// a file or symlink planted under a guessed name is never followed nor reused. The mode
+// is the usual 0666 less the umask, as a plain open would give.
 int createTemporary(const std::string &path, std::string &tmp) {
+    static std::atomic<uint64_t> counter{0};
     const fs::path p(path);
-    static thread_local std::mt19937_64 random{std::random_device{}()};
+    std::random_device random;
     for (int attempt = 0; attempt < 100; ++attempt) {
-        char suffix[17];
-        std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(random()));
-        tmp = (p.parent_path() / (".tmp-" + std::string(suffix) + "-" + p.filename().string())).string();
+        char tag[64];
+        std::snprintf(tag, sizeof tag, ".tmp-%d-%08x%04x-", static_cast<int>(::getpid()), random(),
+                      static_cast<unsigned>(counter++ & 0xffff));
+        tmp = (p.parent_path() / (tag + p.filename().string())).string();
         const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (fd >= 0) return fd;
-        if (errno != EEXIST) throw Error("cannot write " + path + ": " + std::strerror(errno));
+        if (errno != EEXIST) throw Error("cannot write " + path + ": cannot create " + tmp + ": " + std::strerror(errno));
     }
-    throw Error("cannot write " + path + ": no free temporary name beside it");
+    throw Error("cannot write " + path + ": no free temporary name beside it (100 tries)");
 }
 
 void commit(const std::string &tmp, const std::string &path) {
-    // rename() replaces `path` itself, even when it is a symbolic link: it writes through
-    // nothing planted there.
     std::error_code ec;
     fs::rename(tmp, path, ec);
     if (ec) {
@@ -72,19 +74,40 @@ void writeFileAtomic(const std::string &path, const std::string &bytes) {
     std::string tmp;
     const int fd = createTemporary(path, tmp);
     size_t done = 0;
+    int err = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
         if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
+        if (n <= 0) {
+            err = n < 0 ? errno : ENOSPC;
+            break;
+        }
         done += static_cast<size_t>(n);
     }
-    const bool ok = done == bytes.size() && ::fsync(fd) == 0;
-    const int err = errno;
+    if (err == 0 && ::fsync(fd) != 0) err = errno;
     ::close(fd);
-    if (!ok) {
+    if (err != 0) {
         std::error_code ec;
         fs::remove(tmp, ec);
         throw Error("cannot write " + path + ": " + std::strerror(err));
+    }
+    commit(tmp, path);
+}
+
+void writeFileAtomicWith(const std::string &path, const std::function<void(const std::string &tmp)> &write) {
+    std::string tmp;
+    ::close(createTemporary(path, tmp)); // the name is ours; the writer opens it again
+    try {
+        write(tmp);
+    } catch (...) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw;
+    }
+    std::error_code ec;
+    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
+        fs::remove(tmp, ec);
+        throw Error("cannot write " + path + ": the writer produced no file");
     }
     commit(tmp, path);
 }

@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -18,13 +17,16 @@
 namespace binocle {
 
 void writeImage(const std::string &path, const cv::Mat &image) {
-    // Encoded in memory, then written through writeFileAtomic's own temporary (never a
-    // name handed to OpenCV, which would open whatever is there).
-    const std::string ext = std::filesystem::path(path).extension().string();
+    // Encoded in memory, then written through writeFileAtomic's own descriptor: the file is
+    // never opened again by name (a symlink swapped in meanwhile is not followed).
+    const size_t dot = path.rfind('.');
+    const size_t slash = path.rfind('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+        throw Error("cannot write image " + path + ": no extension to choose the format by");
     std::vector<uchar> bytes;
     bool ok = false;
     try {
-        ok = cv::imencode(ext.empty() ? ".png" : ext, image, bytes);
+        ok = cv::imencode(path.substr(dot), image, bytes);
     } catch (const cv::Exception &e) {
         throw Error("cannot write image " + path + ": " + e.err);
     }
