@@ -164,6 +164,7 @@
     CONSTANT(BINOCLE_PARAM_FLAG_ODD, 2)                                            \
     CONSTANT(BINOCLE_PARAM_FLAG_HAS_MIN, 4)                                        \
     CONSTANT(BINOCLE_PARAM_FLAG_HAS_MAX, 8)                                        \
+    CONSTANT(BINOCLE_PARAM_FLAG_LIMIT, 16)                                         \
     CONSTANT(BINOCLE_LOG_DEBUG, 0)                                                 \
     CONSTANT(BINOCLE_LOG_INFO, 1)                                                  \
     CONSTANT(BINOCLE_LOG_WARNING, 2)                                               \
