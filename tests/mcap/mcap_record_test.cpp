@@ -120,9 +120,10 @@ TEST_F(McapRecord, ReplayedBagGivesTheLiveRunsDisparity) {
     // The rig with the bag as its source.
     std::ifstream in(kRig);
     std::string rig((std::istreambuf_iterator<char>(in)), {});
-    const size_t a = rig.find("source:"), b = rig.find("matcher:");
+    // The evaluators are left out: the paper evaluator needs the sim's panel metadata.
+    const size_t a = rig.find("source:"), b = rig.find("matcher:"), e = rig.find("evaluators:"), o = rig.find("outputs:");
     rig = rig.substr(0, a) + "source:\n  plugin: replay\n  bag: " + (dir_ / "bag").string() + "\n  color: gray\n" +
-          rig.substr(b);
+          rig.substr(b, e - b) + rig.substr(o);
     // Paths in the rig (the paper evaluator's scene) are relative to configs/rigs.
     const fs::path rigFile = fs::path(BINOCLE_SOURCE_DIR) / "configs" / "rigs" / (".mcap_test_" + std::to_string(::getpid()) + ".yaml");
     std::ofstream(rigFile) << rig;
