@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/output_folder.hpp"
 
 #include <binocle/ros2_messages.hpp>
 
@@ -73,8 +74,13 @@ RosbagWriter::RosbagWriter(const std::string &dir, const std::optional<StereoCal
     : dir_(dir), options_(options), calibration_(calibration) {
     checkRosbagOptions(options_);
     std::error_code ec;
-    if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
-        throw Error("rosbag: '" + dir + "' exists and is not an empty folder; a bag is never written over anything");
+    if (fs::exists(dir, ec)) {
+        bool empty = fs::is_directory(dir, ec);
+        // The lock of `binocle record`/`run` (core/output_folder.hpp) is not content.
+        for (const auto &e : fs::directory_iterator(dir, ec))
+            if (e.path().filename() != OutputFolder::kLockFile) empty = false;
+        if (!empty) throw Error("rosbag: '" + dir + "' exists and is not an empty folder; a bag is never written over anything");
+    }
     fs::create_directories(dir, ec);
     if (ec) throw Error("rosbag: cannot create folder '" + dir + "': " + ec.message());
     std::string name = fs::path(dir).lexically_normal().filename().string();
