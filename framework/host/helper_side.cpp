@@ -339,6 +339,11 @@ void evaluate(Served &s, Reader &r, const Mapping &m) {
         if (r.get<uint8_t>() == 0) *text = r.cstr(); // else: the same as before
     const auto [hasOutput, output] = r.cstr();
     binocle_eval_input in{};
+    in.min_disparity = r.get<int32_t>();
+    in.num_disparities = r.get<int32_t>();
+    in.ground_pose_known = r.get<int32_t>();
+    in.camera_height_mm = r.get<double>();
+    in.inclination_deg = r.get<double>();
     in.struct_size = sizeof in;
     in.frame = hasFrame ? &frame : nullptr;
     in.rectified_left = has[0] ? &images[0] : nullptr;

@@ -741,6 +741,8 @@ void EvaluatorHelper::evaluate(const binocle_eval_input &in) {
     text(in.calibration_yaml, sentCalibration_, sentCalibrationNull_);
     text(in.rig_yaml, sentRig_, sentRigNull_);
     w.cstr(in.output_dir);
+    w.put<int32_t>(in.min_disparity).put<int32_t>(in.num_disparities).put<int32_t>(in.ground_pose_known);
+    w.put<double>(in.camera_height_mm).put<double>(in.inclination_deg);
     const bool done = guarded([&] {
         layout.copyInto(shared_.reserve(layout.bytes()));
         call("evaluate", helper::kEvaluate, w.data(), &shared_);
