@@ -53,7 +53,7 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                   addRigArgs(app, args->rig);
                   app.add_option("--port", args->options.port, "TCP port (0: any free port)")
                       ->type_name("N")
-                      ->check(CLI::Range(0, 65535))
+                      ->check(wholeNumberIn(0, 65535))
                       ->capture_default_str();
                   app.add_option("--bind", args->options.address, "address to listen on")->type_name("ADDR")->capture_default_str();
                   app.add_option("--out", args->options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
