@@ -290,12 +290,11 @@ TEST_F(RigConfigTest, LeadingZerosNameTheirOctalReadingAndTheDecimalToWrite) {
 }
 
 TEST_F(RigConfigTest, PlainDecimalsAndZeroStillRead) {
-    RigConfig r = loadRig(write(rig("  plugin: sgbm\n  num_disparities: 128\n  isolation: process\n  call_timeout_ms: 0\n") +
+    RigConfig r = loadRig(write(rig("  plugin: sgbm\n  num_disparities: 128\n") +
                                 "runtime:\n  queue_depth: 10\noutputs:\n  max_range_mm: 0.5e5\n"),
                           {Override::parse("transforms.0.inclination_deg=0.5")}, *host_);
     EXPECT_EQ(r.runtime.queue_depth, 10);
     EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 128);
-    EXPECT_EQ(r.matcher.params.isolation().call_timeout_ms, 0);
     EXPECT_DOUBLE_EQ(r.outputs.max_range_mm, 50000);
     EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 0.5);
 }

@@ -24,9 +24,11 @@
 
 namespace binocle::sdk {
 
-// 1500, 0.5, -90: as short as the number allows.
+// 1500, 0.5, -90, 3600000: as short as the number allows, whole numbers in full.
 inline std::string settingNumberText(double v) {
+    if (std::isfinite(v) && v == std::trunc(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v));
     std::ostringstream s;
+    s.precision(15);
     s << v;
     return s.str();
 }
