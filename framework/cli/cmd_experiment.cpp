@@ -2,6 +2,7 @@
 // `binocle experiment FILE`: runs the tests of an experiment (METHOD.md E1, E2).
 #include "cli/command.hpp"
 #include "core/error.hpp"
+#include "core/output_folder.hpp"
 #include "experiment/experiment.hpp"
 #include "report/html_report.hpp"
 
@@ -24,6 +25,7 @@ int merge(const std::vector<std::string> &p) {
     if (p.size() < 2) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
     PluginHost host;
     host.scan();
+    const OutputFolder folder(p[0], OutputClaim{OutputKind::Experiment, false, "binocle experiment merge"});
     const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host);
     spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.rows.size(), p.size() - 1,
                  result.failed, p[0]);
@@ -47,6 +49,7 @@ int experiment(const ExperimentArgs &args) {
     if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
     for (const auto &id : args.tests)
         if (!id.empty()) options.only.push_back(id);
+    const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, false, "binocle experiment"});
     const ExperimentResult result = runExperiment(e, host, options);
     spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",
                  e.name, result.rows.size(), static_cast<int>(result.seconds), result.failed, options.out_dir);

@@ -3,28 +3,17 @@
 // plugin plays back (layout `recording`, plugins/replay/README.md).
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
+#include "core/output_folder.hpp"
 #include "pipeline/recorder.hpp"
+#include "pipeline/stop_signal.hpp"
 
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
-#include <atomic>
-#include <csignal>
 #include <iostream>
 
 namespace binocle::cli {
 namespace {
-
-std::atomic<bool> stopRequested{false};
-
-// First Ctrl-C (or SIGTERM): finish the frame being written and stop. Second: die at once
-// (what is written stays readable either way).
-extern "C" void onStopSignal(int sig) {
-    if (stopRequested.exchange(true)) {
-        std::signal(sig, SIG_DFL);
-        std::raise(sig);
-    }
-}
 
 struct RecordArgs {
     RigArgs rig;
@@ -46,15 +35,16 @@ int record(const RecordArgs &args) {
     options.max_frames = args.frames;
     options.grab_timeout_ms = args.timeout_ms;
     options.progress = !args.quiet;
-    options.stop = &stopRequested;
+    // First Ctrl-C (or SIGTERM, SIGHUP): finish the frames being written and stop.
+    // Second: die at once (what is written stays readable either way).
+    StopSignalGuard signals;
+    options.stop = &StopSignalGuard::requested();
     options.writer.png_compression = args.png_compression;
     options.writer.threads = args.writer_threads;
     if (!args.when_behind.empty()) options.drop_when_behind = args.when_behind == "drop";
-    std::signal(SIGINT, onStopSignal);
-    std::signal(SIGTERM, onStopSignal);
+    // One recorder per folder; the writer itself refuses a folder that holds anything.
+    OutputFolder folder(args.out, OutputClaim{OutputKind::None, false, "binocle record"});
     RecordResult r = recordRig(rig, args.out, options);
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
     spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, args.out, r.seconds);
     // Where every pair that was not written went (also in DIR/summary.json).
     const nlohmann::ordered_json lost = recordingSummary(r)["lost"];

@@ -3,12 +3,14 @@
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
 #include "core/json.hpp"
+#include "core/output_folder.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/stop_signal.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <optional>
 
 namespace binocle::cli {
 namespace {
@@ -17,7 +19,7 @@ struct RunArgs {
     RigArgs rig;
     int64_t frames = -1;
     std::string out;
-    bool quiet = false;
+    bool quiet = false, force = false;
 };
 
 int runRig(const RunArgs &args) {
@@ -29,6 +31,10 @@ int runRig(const RunArgs &args) {
     options.out_dir = args.out;
     options.progress = !args.quiet;
     Pipeline pipeline(rig, host);
+    // Owned until the summary is written: a second run into the same folder is refused,
+    // and so is a folder that holds a recording or an experiment (unless --force).
+    std::optional<OutputFolder> folder;
+    if (!args.out.empty()) folder.emplace(args.out, OutputClaim{OutputKind::Run, args.force, "binocle run"});
     StopSignalGuard signals; // Ctrl-C / SIGTERM: finish the frames in flight, write the summary
     options.stop = &StopSignalGuard::requested();
     Json summary = pipeline.run(options);
@@ -49,7 +55,9 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "  cloud_NNNNNN.ply            binary PLY, millimetres, frame stated in the header\n"
               "and frames.jsonl (one line of figures per frame, written as it finishes) and\n"
               "summary.json (evaluator metrics, drops, status). Without --out the summary goes\n"
-              "to standard output. SIGINT/SIGTERM stop the run cleanly (status interrupted, exit\n"
+              "to standard output. One process writes into DIR at a time; a DIR that holds a\n"
+              "recording or an experiment is refused unless --force (which empties it first).\n"
+              "SIGINT/SIGTERM/SIGHUP stop the run cleanly (status interrupted, exit\n"
               "128 + signal); a second signal ends it at once. The rig's runtime: block sets the\n"
               "policy (README \"Runtime\").\n"
               "Example: binocle run RIG.yaml --frames 10 --set matcher.num_disparities=128 --set transforms.0.inclination_deg=10",
@@ -60,6 +68,8 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
                       ->type_name("N")
                       ->check(atLeast(1));
                   app.add_option("--out", args->out, "output folder (created if needed)")->type_name("DIR");
+                  app.add_flag("--force", args->force,
+                               "replace what --out holds when it is another kind of output (a recording, an experiment)");
                   app.add_flag("--quiet", args->quiet, "no progress display");
                   return [args] { return runRig(*args); };
               }}};

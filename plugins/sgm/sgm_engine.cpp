@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: MIT
+// sgm: the matching of one pair: census of both images, then per stripe of rows the
+// costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over a
+// volume of 16-bit sums), winner takes all with the left-right check, then a median.
+#include "sgm_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace sgm {
+namespace {
+
+std::string mebibytes(double bytes) { return std::to_string(static_cast<long long>(std::ceil(bytes / 1048576.0))); }
+
+} // namespace
+
+Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(settings), kernels_(kernels) {
+    paddedDisp_ = paddedDisparities(settings_.numDisparities);
+    // 5 paths: left, right and the three from above, all in one pass down (no volume).
+    // 4 and 8: the pass down keeps its sums in a volume, the pass up adds the paths from below.
+    twoPass_ = settings_.paths != 5;
+    if (settings_.paths == 4) downDx_ = upDx_ = {0};
+    else if (settings_.paths == 5) downDx_ = {-1, 0, 1};
+    else downDx_ = upDx_ = {-1, 0, 1};
+    // P2 by intensity step g: smaller across an edge, where disparity jumps are likely
+    // (Hirschmueller 2008), never below P1.
+    for (int g = 0; g < 256; ++g) {
+        int p2 = settings_.p2;
+        if (settings_.p2IntensityStep > 0)
+            p2 = settings_.p2 * settings_.p2IntensityStep / (settings_.p2IntensityStep + g);
+        p2Lut_[g] = static_cast<uint8_t>(std::clamp(p2, settings_.p1, 255));
+    }
+}
+
+double Engine::workingBytes(int width, int height) const {
+    const double w = width, h = height, dp = paddedDisp_, ds = pathStride(paddedDisp_);
+    const double rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
+    const double volume = twoPass_ ? w * h * dp * 3 : 0; // 16-bit sums and 8-bit costs
+    const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 2 /* scratch sums */ + 8 * w +
+                          8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
+    return volume + images + std::max(1, settings_.stripes) * stripe;
+}
+
+void Engine::prepare(int width, int height) {
+    if (width == width_ && height == height_) return;
+    const double need = workingBytes(width, height);
+    if (need > settings_.maxMemoryBytes)
+        throw std::invalid_argument(
+            "sgm: paths " + std::to_string(settings_.paths) + " on a " + std::to_string(width) + "x" +
+            std::to_string(height) + " pair with num_disparities " + std::to_string(settings_.numDisparities) +
+            " needs about " + mebibytes(need) + " MiB of working memory" +
+            (twoPass_ ? " (volumes of width x height x num_disparities costs and sums: 3 bytes each)" : "") +
+            "; expected at most max_memory_mb = " + mebibytes(settings_.maxMemoryBytes) + ": use " +
+            (twoPass_ ? "paths 5 (no volume), " : "") + "fewer disparities, smaller images or raise max_memory_mb");
+    width_ = width;
+    height_ = height;
+    const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height), dp = paddedDisp_;
+    const size_t ds = pathStride(paddedDisp_);
+    censusLeft_.assign(w * h, 0);
+    censusRight_.assign(w * h, 0);
+    volume_.assign(twoPass_ ? w * h * dp : 0, 0);
+    costVolume_.assign(twoPass_ ? w * h * dp : 0, 0);
+    stripes_.assign(static_cast<size_t>(std::clamp(settings_.stripes, 1, height)), Stripe{});
+    for (Stripe &s : stripes_) {
+        s.cost.assign(w * dp, kCostInvalid);
+        // The sentinels at d = -1 and d = Dp are written here once and never again.
+        s.pathRows.assign(6 * w * ds, kCostInvalid);
+        s.pathMins.assign(6 * w, 0);
+        s.horizontal.assign(2 * ds, kCostInvalid);
+        s.scratchSum.assign(w * dp, 0);
+        s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
+        s.best.assign(w, -1);
+        s.rightBest.assign(w, -1);
+        s.bestSum.assign(w, 0);
+        s.rightSum.assign(w, 0);
+    }
+    fixed_.create(height, width, CV_16UC1);
+    filtered_.create(height, width, CV_16UC1);
+    ++allocations_;
+}
+
+// The census of every row, rows in parallel. The image is first padded by replication so
+// that the window never leaves it.
+void Engine::censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census) {
+    const int rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
+    cv::copyMakeBorder(grey, padded, ry, ry, rx, rx, cv::BORDER_REPLICATE);
+    cv::parallel_for_(cv::Range(0, height_), [&](const cv::Range &range) {
+        const uint8_t *rows[16];
+        for (int y = range.start; y < range.end; ++y) {
+            for (int j = 0; j < settings_.censusHeight; ++j) rows[j] = padded.ptr<uint8_t>(y + j) + rx;
+            kernels_.censusRow(rows, width_, settings_.censusWidth, settings_.censusHeight,
+                               census.data() + static_cast<size_t>(y) * width_);
+        }
+    });
+}
+
+const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
+    const size_t at = static_cast<size_t>(y) * width_;
+    uint8_t *volumeRow = twoPass_ && own ? costVolume_.data() + at * paddedDisp_ : nullptr;
+    if (volumeRow && !down) return volumeRow; // computed by this stripe's pass down
+    uint8_t *out = volumeRow ? volumeRow : s.cost.data();
+    kernels_.costRow(censusLeft_.data() + at, censusRight_.data() + at, width_, settings_.minDisparity,
+                     settings_.numDisparities, paddedDisp_, s.costScratch.data(), out);
+    return out;
+}
+
+// Winner takes all on one row of sums, then the left-right check: the right image's
+// match of column xr is the left pixel of least sum that chose it (as OpenCV's SGBM
+// derives it, from the same sums); a left pixel whose disparity differs from its right
+// match's by more than disp12_max_diff is invalid (occluded or mismatched).
+void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
+    const WtaParams wp{settings_.minDisparity, settings_.numDisparities, paddedDisp_, settings_.uniquenessPercent,
+                       settings_.subpixel};
+    uint16_t *out = fixed_.ptr<uint16_t>(y);
+    kernels_.wtaRow(sum, width_, wp, s.best.data(), s.bestSum.data(), out);
+    if (settings_.disp12MaxDiff < 0) return;
+    std::fill(s.rightBest.begin(), s.rightBest.end(), -1);
+    std::fill(s.rightSum.begin(), s.rightSum.end(), 0xFFFF);
+    for (int x = 0; x < width_; ++x) {
+        const int d = s.best[x];
+        if (d < 0) continue;
+        const int xr = x - settings_.minDisparity - d;
+        if (s.bestSum[x] < s.rightSum[xr]) {
+            s.rightSum[xr] = s.bestSum[x];
+            s.rightBest[xr] = static_cast<int16_t>(d);
+        }
+    }
+    for (int x = 0; x < width_; ++x) {
+        const int d = s.best[x];
+        if (d < 0 || out[x] == 0) continue;
+        const int xr = x - settings_.minDisparity - d;
+        if (std::abs(s.rightBest[xr] - d) > settings_.disp12MaxDiff) out[x] = 0;
+    }
+}
+
+// Rows y0 .. y1 - 1. The vertical and diagonal paths start kStripeOverlapRows above (and
+// for the pass up, below) the stripe, so that they arrive warmed up; the sums of those
+// rows go to scratch.
+void Engine::matchStripe(int index, int y0, int y1) {
+    Stripe &s = stripes_[static_cast<size_t>(index)];
+    const size_t w = static_cast<size_t>(width_), ds = pathStride(paddedDisp_);
+    const PathParams pp{settings_.p1, p2Lut_};
+    uint8_t *rowsL = s.pathRows.data();
+    uint8_t *mins = s.pathMins.data();
+    // Direction i has two rows (previous, current), swapped after each image row.
+    auto pathL = [&](size_t dir, int parity) { return rowsL + (2 * dir + parity) * w * ds; };
+    auto pathMin = [&](size_t dir, int parity) { return mins + (2 * dir + parity) * w; };
+
+    auto run = [&](const std::vector<int> &dxs, int yFirst, int yLast, int step, bool down) {
+        int parity = 0;
+        for (int y = yFirst;; y += step) {
+            const bool own = y >= y0 && y < y1;
+            const uint8_t *cost = costRow(s, y, own, down);
+            uint16_t *sum = own && twoPass_ ? volumeRow(y) : s.scratchSum.data();
+            bool init = !own || down; // the pass up adds to the pass down's sums
+            if (own && down) {
+                kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                                       s.horizontal.data(), sum, true);
+                init = false;
+            }
+            const bool first = y == yFirst;
+            const uint8_t *greyPrev = first ? nullptr : greyLeft_.ptr<uint8_t>(y - step);
+            RowPaths rp{};
+            rp.count = static_cast<int>(dxs.size());
+            for (size_t i = 0; i < dxs.size(); ++i) {
+                rp.dx[i] = dxs[i];
+                rp.prevL[i] = first ? nullptr : pathL(i, parity ^ 1);
+                rp.prevMin[i] = pathMin(i, parity ^ 1);
+                rp.curL[i] = pathL(i, parity);
+                rp.curMin[i] = pathMin(i, parity);
+            }
+            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, init);
+            if (own && (down != twoPass_)) finishRow(s, sum, y);
+            parity ^= 1;
+            if (y == yLast) break;
+        }
+    };
+    run(downDx_, std::max(0, y0 - kStripeOverlapRows), y1 - 1, 1, true);
+    if (twoPass_) run(upDx_, std::min(height_ - 1, y1 - 1 + kStripeOverlapRows), y0, -1, false);
+}
+
+const cv::Mat &Engine::computeFixed(const cv::Mat &left, const cv::Mat &right) {
+    CV_Assert(left.type() == CV_8UC1 && right.type() == CV_8UC1 && left.size() == right.size());
+    prepare(left.cols, left.rows);
+    greyLeft_ = left;
+    greyRight_ = right;
+    censusImage(left, paddedLeft_, censusLeft_);
+    censusImage(right, paddedRight_, censusRight_);
+    const int n = static_cast<int>(stripes_.size());
+    cv::parallel_for_(cv::Range(0, n), [&](const cv::Range &range) {
+        for (int i = range.start; i < range.end; ++i)
+            matchStripe(i, height_ * i / n, height_ * (i + 1) / n);
+    });
+    return fixed_;
+}
+
+void Engine::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity, float invalid) {
+    CV_Assert(disparity.type() == CV_32FC1 && disparity.size() == left.size());
+    computeFixed(left, right);
+    // A small median removes isolated outliers; an invalid pixel (0) among valid ones
+    // is outvoted, a valid one among invalid ones is dropped.
+    const cv::Mat *result = &fixed_;
+    if (settings_.medianPx > 1) {
+        cv::medianBlur(fixed_, filtered_, settings_.medianPx);
+        result = &filtered_;
+    }
+    const float scale = 1.0f / 16;
+    for (int y = 0; y < height_; ++y) {
+        const uint16_t *src = result->ptr<uint16_t>(y);
+        float *dst = disparity.ptr<float>(y);
+        for (int x = 0; x < width_; ++x) dst[x] = src[x] == 0 ? invalid : static_cast<float>(src[x]) * scale;
+    }
+}
+
+} // namespace sgm

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+// sgm: census + semi-global matching of a grey pair, on reused buffers. Knows nothing of
+// the plugin ABI (the plugin wraps it), so tests can drive it with any kernel table.
+#pragma once
+
+#include "sgm_kernels.hpp"
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace sgm {
+
+struct Settings {
+    int minDisparity = 0;
+    int numDisparities = 64;
+    int censusWidth = 9;
+    int censusHeight = 7;
+    int paths = 4;              // 4 (horizontal + vertical), 5 (one pass), 8
+    int p1 = 10;
+    int p2 = 120;
+    int p2IntensityStep = 30;   // 0: P2 constant; else P2 * s / (s + |intensity step|), >= p1
+    int uniquenessPercent = 8;
+    int disp12MaxDiff = 1;      // -1: no left-right check
+    bool subpixel = true;
+    int medianPx = 5;           // 1: none
+    int stripes = 4;
+    double maxMemoryBytes = 2048.0 * 1048576.0;
+};
+
+// Rows a stripe runs its vertical paths above (and below) its own rows before they count:
+// stripes are matched independently, in parallel.
+constexpr int kStripeOverlapRows = 16;
+
+class Engine {
+public:
+    Engine(const Settings &settings, const Kernels &kernels);
+
+    // left, right: CV_8UC1, same size. disparity: CV_32FC1 of that size (may be a view of
+    // the caller's buffer): pixels, `invalid` where no match survived the checks.
+    void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity, float invalid);
+
+    // The same, stopping before the median filter and the conversion: (minD + d) * 16,
+    // 0 = invalid. For tests.
+    const cv::Mat &computeFixed(const cv::Mat &left, const cv::Mat &right);
+
+    // Bytes of working memory a width x height pair needs (what max_memory_mb bounds).
+    double workingBytes(int width, int height) const;
+    // How often the buffers were (re)allocated: once per image size.
+    int allocations() const { return allocations_; }
+    const Kernels &kernels() const { return kernels_; }
+
+private:
+    struct Stripe {
+        std::vector<uint8_t> cost, pathRows, pathMins, horizontal;
+        std::vector<uint16_t> scratchSum;
+        std::vector<uint64_t> costScratch;
+        std::vector<int16_t> best, rightBest;
+        std::vector<uint16_t> bestSum, rightSum;
+    };
+    void prepare(int width, int height);
+    void censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census);
+    void matchStripe(int stripe, int y0, int y1);
+    // The costs of row y: computed into the stripe's row (or into the cost volume, for a
+    // row of the stripe's own in the pass down), or read back from the volume.
+    const uint8_t *costRow(Stripe &s, int y, bool own, bool down);
+    void finishRow(Stripe &s, const uint16_t *sum, int y);
+    uint16_t *volumeRow(int y) { return volume_.data() + static_cast<size_t>(y) * width_ * paddedDisp_; }
+
+    Settings settings_;
+    const Kernels &kernels_;
+    int width_ = 0, height_ = 0, paddedDisp_ = 0;
+    bool twoPass_ = true;
+    std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
+    uint8_t p2Lut_[256];
+    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_, filtered_;
+    std::vector<uint64_t> censusLeft_, censusRight_;
+    std::vector<uint16_t> volume_;  // 4 and 8 paths: the pass down's sums
+    std::vector<uint8_t> costVolume_; // and its costs, which the pass up reads again
+    std::vector<Stripe> stripes_;
+    int allocations_ = 0;
+};
+
+} // namespace sgm

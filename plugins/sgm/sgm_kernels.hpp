@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: MIT
+// sgm: the per-row kernels of census + semi-global matching, one table per instruction set.
+//
+// Every kernel exists as a plain scalar reference (sgm_kernels_scalar.cpp) and as SIMD
+// code written once with OpenCV's universal intrinsics (sgm_kernels_simd.inl), compiled
+// for the compiler's baseline (SSE2 on x86-64, NEON on aarch64) and, on x86-64, for
+// AVX2. The tables must agree bit for bit: tests/plugins_sgm checks it.
+//
+// Layouts shared by all kernels (D = num_disparities, Dp = D rounded up to kDispAlign):
+//  - cost row: width x Dp bytes, cost of pixel x at disparity d at [x * Dp + d];
+//    d >= D and candidates left of the right image hold kCostInvalid;
+//  - path row (L): width x (Dp + 2) bytes; pixel x's costs at [x * (Dp + 2) + 1 + d],
+//    with a sentinel kCostInvalid at d = -1 and d = Dp so that the d - 1 and d + 1
+//    neighbours are plain loads;
+//  - sum row (S): width x Dp 16-bit sums of the path costs.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sgm {
+
+// The helpers below are `static`: each file has its own copy, so the linker never hands
+// a baseline caller the copy compiled for AVX2 (sgm_kernels_avx2.cpp includes this too).
+
+// Disparity counts are padded to a multiple of this (the widest vector, AVX2's 32 bytes),
+// so that every table works on the same buffers.
+constexpr int kDispAlign = 32;
+constexpr uint8_t kCostInvalid = 255;
+
+static inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
+static inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
+
+// Census bits of one row. rows[j] points at image column 0 of the grey row y + j - ch/2 of
+// an image padded by cw/2 columns on each side (so rows[j][x + dx] is readable for
+// |dx| <= cw/2). Bit k of out[x] is set when neighbour k (row-major order in the cw x ch
+// window, the centre skipped) is darker than the centre.
+using CensusRowFn = void (*)(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out);
+
+// Words of scratch costRow needs (the right census row rearranged for vector loads).
+using CostScratchFn = size_t (*)(int width, int minDisparity, int paddedDisp);
+
+// Hamming costs of one row: cost[x * Dp + d] = popcount(left[x] ^ right[x - minD - d]),
+// kCostInvalid where x - minD - d < 0 or d >= numDisp.
+using CostRowFn = void (*)(const uint64_t *left, const uint64_t *right, int width, int minDisparity, int numDisp,
+                           int paddedDisp, uint64_t *scratch, uint8_t *cost);
+
+// What one path direction needs besides the costs.
+struct PathParams {
+    int p1;               // penalty for a change of 1 px
+    const uint8_t *p2Lut; // penalty for larger changes, by |intensity step| (256 entries, >= p1)
+};
+
+// One row of up to kMaxRowPaths paths whose predecessors lie in the previous row
+// (vertical or diagonal), all added to sum in one pass. Path i: pixel x follows pixel
+// x + dx[i] of prevL[i] (dx in -1, 0, 1); a pixel without predecessor (prevL[i] NULL, or
+// x + dx[i] outside) starts the path. grey/greyPrev: the intensities of this row and of
+// the previous one, for the penalty P2. Writes curL[i] and curMin[i], and adds the
+// row's path costs to sum (or stores them when initSum).
+constexpr int kMaxRowPaths = 3;
+struct RowPaths {
+    int count;
+    int dx[kMaxRowPaths];
+    const uint8_t *prevL[kMaxRowPaths];
+    const uint8_t *prevMin[kMaxRowPaths];
+    uint8_t *curL[kMaxRowPaths];
+    uint8_t *curMin[kMaxRowPaths];
+};
+using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                           const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum);
+
+// One row of both horizontal paths, left to right and right to left, added to sum (or
+// stored, when initSum); scratch: 2 * pathStride(paddedDisp) bytes.
+using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
+                                 const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
+
+// Winner takes all over one row of sums, d in [0, numDisp). For every pixel:
+// best[x] = the lowest d of least sum (-1 where no candidate lies inside the right
+// image), bestSum[x] that sum, and disparity16[x] = (minD + d) * 16 + sub-pixel part
+// (parabola through the neighbours' sums, in 1/16 px), 0 where invalid: no candidate, or
+// not unique (another d, away from best by more than 1, has sum * (100 - uniqueness) <
+// bestSum * 100).
+struct WtaParams {
+    int minDisparity;
+    int numDisp;
+    int paddedDisp;
+    int uniquenessPercent;
+    bool subpixel;
+};
+using WtaRowFn = void (*)(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
+                          uint16_t *disparity16);
+
+struct Kernels {
+    const char *name;
+    CensusRowFn censusRow;
+    CostScratchFn costScratchWords;
+    CostRowFn costRow;
+    PathRowFn pathRow;
+    HorizontalRowFn horizontalRow;
+    WtaRowFn wtaRow;
+};
+
+const Kernels &scalarKernels();
+// SIMD of the compiler's baseline; NULL when OpenCV has no universal intrinsics here.
+const Kernels *baselineKernels();
+// AVX2 (x86-64 only); NULL when not built in or when this CPU lacks AVX2.
+const Kernels *avx2Kernels();
+// The fastest table this CPU runs.
+const Kernels &bestKernels();
+
+// The sub-pixel refinement shared by every table (scalar per pixel: no SIMD to compare).
+// Returns (minD + d) * 16 + the parabola's offset in 1/16 px, or 0 when that is <= 0.
+static inline uint16_t refinedDisparity16(const uint16_t *s, int d, const WtaParams &wp) {
+    int value = (wp.minDisparity + d) * 16;
+    if (wp.subpixel && d > 0 && d < wp.numDisp - 1) {
+        const int left = s[d - 1], right = s[d + 1], centre = s[d];
+        const int denom = left + right - 2 * centre > 1 ? left + right - 2 * centre : 1;
+        // Rounded to the nearest 1/16 px as OpenCV's SGBM does (truncating division of a
+        // value offset by half the divisor).
+        value += ((left - right) * 16 + denom) / (2 * denom);
+    }
+    return value > 0 ? static_cast<uint16_t>(value) : 0;
+}
+
+} // namespace sgm

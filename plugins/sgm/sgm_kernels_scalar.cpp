@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: MIT
+// sgm: the scalar reference of every kernel: the plainest code that states what the SIMD
+// versions must compute, bit for bit (8-bit path costs saturate exactly as theirs do).
+#include "sgm_kernels.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <iterator>
+
+namespace sgm {
+namespace {
+
+inline uint8_t addSat(int a, int b) { return static_cast<uint8_t>(std::min(255, a + b)); }
+inline uint8_t subSat(int a, int b) { return static_cast<uint8_t>(std::max(0, a - b)); }
+
+void censusRowScalar(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
+    const int rx = cw / 2, ry = ch / 2;
+    for (int x = 0; x < width; ++x) {
+        const uint8_t centre = rows[ry][x];
+        uint64_t bits = 0;
+        int k = 0;
+        for (int j = 0; j < ch; ++j)
+            for (int dx = -rx; dx <= rx; ++dx) {
+                if (j == ry && dx == 0) continue;
+                bits |= static_cast<uint64_t>(rows[j][x + dx] < centre) << k;
+                ++k;
+            }
+        out[x] = bits;
+    }
+}
+
+size_t costScratchScalar(int, int, int) { return 0; }
+
+void costRowScalar(const uint64_t *left, const uint64_t *right, int width, int minD, int numDisp, int paddedDisp,
+                   uint64_t *, uint8_t *cost) {
+    for (int x = 0; x < width; ++x)
+        for (int d = 0; d < paddedDisp; ++d) {
+            const int xr = x - minD - d;
+            cost[static_cast<size_t>(x) * paddedDisp + d] =
+                d < numDisp && xr >= 0 ? static_cast<uint8_t>(__builtin_popcountll(left[x] ^ right[xr])) : kCostInvalid;
+        }
+}
+
+// L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + P1, min L(q) + P2) - min L(q), q the
+// predecessor, all in saturating 8-bit arithmetic. Adds L to sum; returns min L(p).
+uint8_t pathStep(const uint8_t *cost, const uint8_t *prev, int minPrev, int p1, int p2, uint8_t *out, uint16_t *sum,
+                 int paddedDisp, bool initSum) {
+    const uint8_t jump = addSat(minPrev, p2);
+    uint8_t least = 255;
+    for (int d = 0; d < paddedDisp; ++d) {
+        uint8_t t = std::min(prev[d], addSat(std::min(prev[d - 1], prev[d + 1]), p1));
+        t = std::min(t, jump);
+        const uint8_t l = addSat(cost[d], subSat(t, minPrev));
+        out[d] = l;
+        least = std::min(least, l);
+        sum[d] = static_cast<uint16_t>(initSum ? l : std::min(65535, sum[d] + l));
+    }
+    return least;
+}
+
+// A predecessor that is not there: every cost at the sentinel, so that L = C.
+struct Fresh {
+    uint8_t data[kDispAlign * 9 + 2];
+    Fresh() { std::fill(std::begin(data), std::end(data), kCostInvalid); }
+};
+const uint8_t *freshPath() {
+    static const Fresh fresh;
+    return fresh.data + 1;
+}
+
+void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                   const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+    const int stride = pathStride(paddedDisp);
+    for (int i = 0; i < paths.count; ++i)
+        for (int x = 0; x < width; ++x) {
+            const int xp = x + paths.dx[i];
+            const bool has = paths.prevL[i] && xp >= 0 && xp < width;
+            const uint8_t *prev = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+            const int minPrev = has ? paths.prevMin[i][xp] : 255;
+            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            paths.curMin[i][x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2,
+                                          paths.curL[i] + static_cast<size_t>(x) * stride + 1,
+                                          sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum && i == 0);
+        }
+}
+
+void horizontalPath(const uint8_t *cost, int width, int paddedDisp, bool forward, const uint8_t *grey,
+                    const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum) {
+    const int stride = pathStride(paddedDisp);
+    uint8_t *bufs[2] = {scratch + 1, scratch + stride + 1};
+    const uint8_t *prev = freshPath();
+    int minPrev = 255, previousX = -1;
+    for (int i = 0; i < width; ++i) {
+        const int x = forward ? i : width - 1 - i;
+        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        uint8_t *out = bufs[i & 1];
+        minPrev = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2, out,
+                           sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum);
+        prev = out;
+        previousX = x;
+    }
+}
+
+void horizontalRowScalar(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
+                         uint8_t *scratch, uint16_t *sum, bool initSum) {
+    horizontalPath(cost, width, paddedDisp, false, grey, pp, scratch, sum, initSum);
+    horizontalPath(cost, width, paddedDisp, true, grey, pp, scratch, sum, false);
+}
+
+void wtaRowScalar(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
+                  uint16_t *disparity16) {
+    for (int x = 0; x < width; ++x) {
+        const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
+        int b = 0;
+        for (int d = 1; d < wp.numDisp; ++d)
+            if (s[d] < s[b]) b = d;
+        bestSum[x] = s[b];
+        if (x - wp.minDisparity - b < 0) {
+            best[x] = -1;
+            disparity16[x] = 0;
+            continue;
+        }
+        best[x] = static_cast<int16_t>(b);
+        bool unique = true;
+        for (int d = 0; d < wp.numDisp && unique; ++d)
+            if (std::abs(d - b) > 1 && s[d] * (100 - wp.uniquenessPercent) < s[b] * 100) unique = false;
+        disparity16[x] = unique ? refinedDisparity16(s, b, wp) : 0;
+    }
+}
+
+} // namespace
+
+const Kernels &scalarKernels() {
+    static const Kernels k{"scalar", censusRowScalar, costScratchScalar, costRowScalar,
+                           pathRowScalar, horizontalRowScalar, wtaRowScalar};
+    return k;
+}
+
+} // namespace sgm

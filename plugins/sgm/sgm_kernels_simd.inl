@@ -1,0 +1,303 @@
+// SPDX-License-Identifier: MIT
+// sgm: the SIMD kernels, written once with OpenCV's universal intrinsics and compiled
+// once per instruction set (sgm_kernels_baseline.cpp, sgm_kernels_avx2.cpp). The
+// including file defines SGM_SIMD_NS, a namespace of its own: the same inline code
+// compiled with other flags must not be merged by the linker.
+//
+// What each kernel computes is stated by its scalar reference (sgm_kernels_scalar.cpp).
+#ifndef SGM_SIMD_NS
+#error "define SGM_SIMD_NS before including sgm_kernels_simd.inl"
+#endif
+
+#include "sgm_kernels.hpp"
+
+#include <opencv2/core/hal/intrin.hpp>
+
+#include <cstdlib>
+#include <utility>
+
+#if CV_SIMD
+
+namespace sgm {
+namespace SGM_SIMD_NS {
+namespace {
+
+using namespace cv;
+
+constexpr int kLanes8 = v_uint8::nlanes;
+constexpr int kLanes16 = v_uint16::nlanes;
+constexpr int kLanes64 = v_uint64::nlanes;
+static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole vectors");
+
+inline int addSat(int a, int b) { return a + b > 255 ? 255 : a + b; }
+
+// ---- census ---------------------------------------------------------------------------
+// kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
+// byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
+// one 64-bit word per pixel.
+void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
+    const int rx = cw / 2, ry = ch / 2;
+    int x = 0;
+    for (; x + kLanes8 <= width; x += kLanes8) {
+        const v_uint8 centre = vx_load(rows[ry] + x);
+        v_uint8 plane[8];
+        for (auto &p : plane) p = vx_setzero_u8();
+        int k = 0;
+        for (int j = 0; j < ch; ++j)
+            for (int dx = -rx; dx <= rx; ++dx) {
+                if (j == ry && dx == 0) continue;
+                const v_uint8 darker = vx_load(rows[j] + x + dx) < centre;
+                plane[k >> 3] = plane[k >> 3] | (darker & vx_setall_u8(static_cast<uint8_t>(1u << (k & 7))));
+                ++k;
+            }
+        // bytes -> 16-bit pairs -> 32-bit quads -> 64-bit words, pixel order kept.
+        v_uint8 z[8];
+        for (int b = 0; b < 4; ++b) v_zip(plane[2 * b], plane[2 * b + 1], z[2 * b], z[2 * b + 1]);
+        v_uint16 w[8]; // w[0..3]: planes 0-3 of pixel quarters 0..3; w[4..7]: planes 4-7
+        for (int half = 0; half < 2; ++half) {
+            v_zip(v_reinterpret_as_u16(z[half]), v_reinterpret_as_u16(z[2 + half]), w[2 * half], w[2 * half + 1]);
+            v_zip(v_reinterpret_as_u16(z[4 + half]), v_reinterpret_as_u16(z[6 + half]), w[4 + 2 * half], w[4 + 2 * half + 1]);
+        }
+        for (int q = 0; q < 4; ++q) {
+            v_uint32 lo, hi;
+            v_zip(v_reinterpret_as_u32(w[q]), v_reinterpret_as_u32(w[4 + q]), lo, hi);
+            v_store(out + x + (2 * q) * kLanes64, v_reinterpret_as_u64(lo));
+            v_store(out + x + (2 * q + 1) * kLanes64, v_reinterpret_as_u64(hi));
+        }
+    }
+    // The last pixels of a row that is not a whole number of vectors.
+    for (; x < width; ++x) {
+        const uint8_t centre = rows[ry][x];
+        uint64_t bits = 0;
+        int k = 0;
+        for (int j = 0; j < ch; ++j)
+            for (int dx = -rx; dx <= rx; ++dx) {
+                if (j == ry && dx == 0) continue;
+                bits |= static_cast<uint64_t>(rows[j][x + dx] < centre) << k;
+                ++k;
+            }
+        out[x] = bits;
+    }
+}
+
+// ---- costs ----------------------------------------------------------------------------
+// The candidates of pixel x, right[x - minD - d] for d = 0, 1, ..., run backwards through
+// the right census row. The row is reversed (rev[j] = right[width - 1 - j]) and split by
+// residue (plane s holds rev[8q + s]) so that one vector load of plane (r + k) mod 8
+// gives the candidates d = 8i + k (lane i) of a block: after popcount each 64-bit lane
+// holds one cost in its low byte, and shifting plane k's costs by 8k bits and OR-ing the
+// eight puts cost d at byte d, in order.
+size_t planeWords(int width, int minD, int paddedDisp) {
+    return static_cast<size_t>((width + minD + paddedDisp + 8) / 8 + kLanes64 + 2);
+}
+
+size_t costScratch(int width, int minD, int paddedDisp) { return 8 * planeWords(width, minD, paddedDisp); }
+
+void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, int numDisp, int paddedDisp,
+             uint64_t *scratch, uint8_t *cost) {
+    const size_t words = planeWords(width, minD, paddedDisp);
+    for (int s = 0; s < 8; ++s) {
+        uint64_t *plane = scratch + s * words;
+        for (size_t q = 0; q < words; ++q) {
+            const size_t j = 8 * q + s;
+            plane[q] = j < static_cast<size_t>(width) ? right[width - 1 - j] : 0;
+        }
+    }
+    alignas(64) uint8_t iotaBytes[kLanes8];
+    for (int i = 0; i < kLanes8; ++i) iotaBytes[i] = static_cast<uint8_t>(i);
+    const v_uint8 iota = vx_load_aligned(iotaBytes);
+    const v_uint8 invalid = vx_setall_u8(kCostInvalid);
+    for (int x = 0; x < width; ++x) {
+        const v_uint64 centre = vx_setall_u64(left[x]);
+        const int base = width - 1 - x + minD;
+        // Lanes d < valid are real candidates: inside the right image and below numDisp.
+        const int valid = std::min(numDisp, x - minD + 1);
+        uint8_t *out = cost + static_cast<size_t>(x) * paddedDisp;
+        for (int d0 = 0; d0 < paddedDisp; d0 += kLanes8) {
+            const int at = base + d0, q = at >> 3, r = at & 7;
+            v_uint64 word = vx_setzero_u64();
+            for (int k = 0; k < 8; ++k) {
+                const int s = r + k;
+                const uint64_t *plane = scratch + (s & 7) * words + q + (s >> 3);
+                word = word | (v_popcount(vx_load(plane) ^ centre) << (8 * k));
+            }
+            v_uint8 c = v_reinterpret_as_u8(word);
+            const int lanes = valid - d0;
+            if (lanes < kLanes8) c = v_select(iota < vx_setall_u8(static_cast<uint8_t>(lanes > 0 ? lanes : 0)), c, invalid);
+            v_store(out + d0, c);
+        }
+    }
+}
+
+// ---- paths ----------------------------------------------------------------------------
+struct Fresh {
+    uint8_t data[kDispAlign * 9 + 2];
+    Fresh() {
+        for (auto &v : data) v = kCostInvalid;
+    }
+};
+const uint8_t *freshPath() {
+    static const Fresh fresh;
+    return fresh.data + 1;
+}
+
+// L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + P1, min L(q) + P2) - min L(q) for the
+// paths of a row side by side, pixel by pixel, so that the 16-bit sums are read and
+// written once per pixel whatever the number of paths.
+void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+    const int stride = pathStride(paddedDisp);
+    const int n = paths.count;
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    for (int x = 0; x < width; ++x) {
+        const uint8_t *prev[kMaxRowPaths];
+        uint8_t *out[kMaxRowPaths];
+        v_uint8 base[kMaxRowPaths], jump[kMaxRowPaths], least[kMaxRowPaths];
+        for (int i = 0; i < n; ++i) {
+            const int xp = x + paths.dx[i];
+            const bool has = paths.prevL[i] && xp >= 0 && xp < width;
+            prev[i] = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+            const int minPrev = has ? paths.prevMin[i][xp] : 255;
+            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            base[i] = vx_setall_u8(static_cast<uint8_t>(minPrev));
+            jump[i] = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            least[i] = vx_setall_u8(255);
+            out[i] = paths.curL[i] + static_cast<size_t>(x) * stride + 1;
+        }
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const v_uint8 c = vx_load(c0 + d);
+            v_uint16 lo = initSum ? vx_setzero_u16() : vx_load(s0 + d);
+            v_uint16 hi = initSum ? vx_setzero_u16() : vx_load(s0 + d + kLanes16);
+            for (int i = 0; i < n; ++i) {
+                // + and - on 8- and 16-bit lanes saturate in OpenCV's universal intrinsics.
+                const uint8_t *q = prev[i] + d;
+                const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+                const v_uint8 t = v_min(v_min(vx_load(q), steps), jump[i]);
+                const v_uint8 l = c + (t - base[i]);
+                v_store(out[i] + d, l);
+                least[i] = v_min(least[i], l);
+                v_uint16 l0, l1;
+                v_expand(l, l0, l1);
+                lo += l0;
+                hi += l1;
+            }
+            v_store(s0 + d, lo);
+            v_store(s0 + d + kLanes16, hi);
+        }
+        for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+    }
+}
+
+// Both horizontal paths of a row, left to right and right to left, interleaved: each is
+// a serial chain (a pixel needs its predecessor's minimum), so running the two side by
+// side lets the CPU overlap their latencies. Each carries its previous pixel's costs in
+// whole vectors (the d - 1 and d + 1 neighbours by lane shifts, not by loads at +-1
+// byte, which would stall on store forwarding at every pixel).
+struct HorizontalChain {
+    static constexpr int kMaxChunks = (kDispAlign * 8) / kLanes8; // 256 disparities
+    v_uint8 bufA[kMaxChunks], bufB[kMaxChunks];
+    v_uint8 *prev = bufA, *cur = bufB;
+    int minPrev = 255, previousX = -1;
+
+    void step(const uint8_t *cost, int chunks, int paddedDisp, int x, const uint8_t *grey, const PathParams &pp,
+              const v_uint8 &p1, uint16_t *sum, bool initSum) {
+        const v_uint8 invalid = vx_setall_u8(kCostInvalid);
+        if (previousX < 0)
+            for (int c = 0; c < chunks; ++c) prev[c] = invalid;
+        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        v_uint8 least = invalid;
+        for (int c = 0; c < chunks; ++c) {
+            const v_uint8 below = v_extract<kLanes8 - 1>(c > 0 ? prev[c - 1] : invalid, prev[c]); // d - 1
+            const v_uint8 above = v_extract<1>(prev[c], c + 1 < chunks ? prev[c + 1] : invalid);  // d + 1
+            const v_uint8 t = v_min(v_min(prev[c], v_min(below, above) + p1), jump);
+            const v_uint8 l = vx_load(c0 + c * kLanes8) + (t - base);
+            cur[c] = l;
+            least = v_min(least, l);
+            v_uint16 lo, hi;
+            v_expand(l, lo, hi);
+            uint16_t *s = s0 + c * kLanes8;
+            if (initSum) {
+                v_store(s, lo);
+                v_store(s + kLanes16, hi);
+            } else {
+                v_store(s, vx_load(s) + lo);
+                v_store(s + kLanes16, vx_load(s + kLanes16) + hi);
+            }
+        }
+        minPrev = v_reduce_min(least);
+        std::swap(prev, cur);
+        previousX = x;
+    }
+};
+
+void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
+                   uint8_t *, uint16_t *sum, bool initSum) {
+    const int chunks = paddedDisp / kLanes8;
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    HorizontalChain forward, backward;
+    for (int i = 0; i < width; ++i) {
+        const int xb = width - 1 - i;
+        // Sums are exact (at most 8 x 255), so the order of the additions does not
+        // matter; the first path to reach a pixel stores instead of adding.
+        forward.step(cost, chunks, paddedDisp, i, grey, pp, p1, sum, initSum && i <= xb);
+        backward.step(cost, chunks, paddedDisp, xb, grey, pp, p1, sum, initSum && xb > i);
+    }
+}
+
+// ---- winner takes all -----------------------------------------------------------------
+void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
+            uint16_t *disparity16) {
+    const int whole = wp.numDisp / kLanes16 * kLanes16;
+    for (int x = 0; x < width; ++x) {
+        const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
+        v_uint16 least = vx_setall_u16(0xFFFF);
+        for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
+        int m = v_reduce_min(least);
+        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
+        // One more pass finds the lowest d holding the least sum and counts the sums below
+        // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
+        const int a = 100 - wp.uniquenessPercent;
+        const int threshold = std::min(65535, (m * 100 + a - 1) / a);
+        const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
+        const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
+        int b = -1, below = 0;
+        for (int d = 0; d < whole; d += kLanes16) {
+            const v_uint16 v = vx_load(s + d);
+            const unsigned eq = static_cast<unsigned>(v_signmask(v == vm));
+            if (b < 0 && eq != 0) b = d + __builtin_ctz(eq);
+            below += __builtin_popcount(static_cast<unsigned>(v_signmask(v < vt)));
+        }
+        for (int d = whole; d < wp.numDisp; ++d) {
+            if (b < 0 && s[d] == m) b = d;
+            below += s[d] < threshold;
+        }
+        bestSum[x] = static_cast<uint16_t>(m);
+        if (x - wp.minDisparity - b < 0) {
+            best[x] = -1;
+            disparity16[x] = 0;
+            continue;
+        }
+        best[x] = static_cast<int16_t>(b);
+        // Those at b - 1, b, b + 1 do not count.
+        for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
+        disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+    }
+}
+
+} // namespace
+
+const Kernels &table(const char *name) {
+    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, wtaRow};
+    return k;
+}
+
+} // namespace SGM_SIMD_NS
+} // namespace sgm
+
+#endif // CV_SIMD

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: MIT
+// sgm: census + semi-global matching, a Matcher plugin built on the Binocle SDK alone
+// (binocle/plugin.hpp) and OpenCV. The settings, the checks of the ABI's inputs, and the
+// conversion to the ABI's disparity; the matching itself is sgm_engine.cpp.
+#include "sgm_engine.hpp"
+#include "sgm_kernels.hpp"
+
+#include <binocle/plugin.hpp>
+
+#include <cmath>
+#include <memory>
+#include <new>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using binocle::sdk::Error;
+using binocle::sdk::Param;
+
+std::string number(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+std::string formatName(int32_t format) {
+    switch (format) {
+    case BINOCLE_PIXEL_GRAY8: return "GRAY8";
+    case BINOCLE_PIXEL_GRAY16: return "GRAY16";
+    case BINOCLE_PIXEL_BGR8: return "BGR8";
+    case BINOCLE_PIXEL_RGB8: return "RGB8";
+    case BINOCLE_PIXEL_FLOAT32: return "FLOAT32";
+    default: return "unknown format " + std::to_string(format);
+    }
+}
+
+std::string sizeText(const binocle_image &im) { return std::to_string(im.width) + "x" + std::to_string(im.height); }
+
+[[noreturn]] void refuse(const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "sgm: " + what); }
+
+class SgmMatcher : public binocle::sdk::Matcher {
+public:
+    static std::vector<binocle_param_desc> parameters() {
+        return {
+            Param::integer("min_disparity", "0").min(0).max(1024).unit("px")
+                .help("smallest disparity searched"),
+            Param::integer("num_disparities", "64").min(16).max(256).multipleOf(16).unit("px")
+                .help("disparities min_disparity .. min_disparity + num_disparities - 1 are searched"),
+            Param::integer("census_width_px", "9").min(3).max(11).odd().unit("px")
+                .help("width of the census window; width x height - 1 <= 64 bits (9 x 7, 11 x 5, 7 x 9 ...)"),
+            Param::integer("census_height_px", "7").min(3).max(9).odd().unit("px")
+                .help("height of the census window"),
+            Param::choice("paths", "4", "4|5|8")
+                .help("aggregation paths: 8 (all), 4 (horizontal and vertical) or 5 (left, right and the three from above: one pass, no volume, least memory)"),
+            Param::integer("p1", "10").min(1).max(253)
+                .help("penalty for a disparity change of 1 px between neighbours, in census bits"),
+            Param::integer("p2", "120").min(2).max(254)
+                .help("penalty for a larger change, > p1; census bits + p2 <= 255 (8-bit path costs)"),
+            Param::integer("p2_intensity_step", "30").min(0).max(255)
+                .help("0 = p2 constant; else p2 * s / (s + |intensity step|), never below p1: cheaper jumps across edges"),
+            Param::integer("uniqueness_ratio", "8").min(0).max(99).unit("%")
+                .help("the best sum must beat every other (away from +-1 px) by this margin; 0 = no check"),
+            Param::integer("disp12_max_diff", "1").min(-1).max(1024).unit("px")
+                .help("largest difference allowed in the left-right consistency check; -1 = no check"),
+            Param::boolean("subpixel", true)
+                .help("refine each disparity by a parabola through the neighbouring sums (1/16 px)"),
+            Param::integer("median_px", "5").min(1).max(5).odd().unit("px")
+                .help("side of the median filter on the disparity; 1 = none"),
+            Param::integer("stripes", "4").min(1).max(64)
+                .help("horizontal stripes matched in parallel (each warms its paths up on 16 rows of the next); the result depends on it, not on the thread count"),
+            Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
+                .help("refuse a pair whose working memory (with 4 or 8 paths: width x height x num_disparities x 2 bytes and more) would exceed this"),
+            Param::choice("kernels", "auto", "auto|avx2|baseline|scalar")
+                .help("instruction set: auto (the fastest this CPU runs), avx2, baseline (SSE2 / NEON) or scalar (the reference)"),
+        };
+    }
+
+    SgmMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host) {
+        checkAgainstTable(p);
+        sgm::Settings s;
+        s.minDisparity = static_cast<int>(p.integer("min_disparity"));
+        s.numDisparities = static_cast<int>(p.integer("num_disparities"));
+        s.censusWidth = static_cast<int>(p.integer("census_width_px"));
+        s.censusHeight = static_cast<int>(p.integer("census_height_px"));
+        s.paths = std::stoi(p.string("paths"));
+        s.p1 = static_cast<int>(p.integer("p1"));
+        s.p2 = static_cast<int>(p.integer("p2"));
+        s.p2IntensityStep = static_cast<int>(p.integer("p2_intensity_step"));
+        s.uniquenessPercent = static_cast<int>(p.integer("uniqueness_ratio"));
+        s.disp12MaxDiff = static_cast<int>(p.integer("disp12_max_diff"));
+        s.subpixel = p.boolean("subpixel");
+        s.medianPx = static_cast<int>(p.integer("median_px"));
+        s.stripes = static_cast<int>(p.integer("stripes"));
+        s.maxMemoryBytes = static_cast<double>(p.integer("max_memory_mb")) * 1048576.0;
+        const int bits = s.censusWidth * s.censusHeight - 1;
+        if (bits > 64)
+            refuse("census window " + std::to_string(s.censusWidth) + " x " + std::to_string(s.censusHeight) + " = " +
+                   std::to_string(bits) + " bits: expected census_width_px x census_height_px - 1 <= 64 (9 x 7, 11 x 5, 7 x 9)");
+        if (s.p2 <= s.p1)
+            refuse("p2 = " + std::to_string(s.p2) + ": expected more than p1 = " + std::to_string(s.p1));
+        if (bits + s.p2 > 255)
+            refuse("p2 = " + std::to_string(s.p2) + ": expected at most " + std::to_string(255 - bits) +
+                   " = 255 - the census window's " + std::to_string(bits) + " bits (path costs are 8-bit)");
+        engine_ = std::make_unique<sgm::Engine>(s, kernelsOf(p.string("kernels")));
+        minDisparity_ = s.minDisparity;
+        numDisparities_ = s.numDisparities;
+        host.debug("census " + std::to_string(s.censusWidth) + "x" + std::to_string(s.censusHeight) + ", paths " +
+                   std::to_string(s.paths) + ", p1 " + std::to_string(s.p1) + ", p2 " + std::to_string(s.p2) +
+                   ", kernels " + engine_->kernels().name);
+    }
+
+    void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) override {
+        checkImages(left, right, disparity);
+        try {
+            cv::Mat out(disparity.height, disparity.width, CV_32FC1, disparity.data,
+                        static_cast<size_t>(disparity.stride_bytes));
+            engine_->compute(grey(left, greyLeft_), grey(right, greyRight_), out, BINOCLE_INVALID_DISPARITY);
+        } catch (const std::invalid_argument &e) {
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, e.what());
+        } catch (const std::bad_alloc &) {
+            throw Error(BINOCLE_ERR_INTERNAL, "sgm: out of memory matching a " + sizeText(left) + " pair");
+        } catch (const cv::Exception &e) {
+            throw Error(BINOCLE_ERR_INTERNAL, "sgm: OpenCV failed on a " + sizeText(left) + " pair: " + e.err);
+        }
+    }
+
+    std::pair<int32_t, int32_t> disparityRange() const override { return {minDisparity_, numDisparities_}; }
+
+private:
+    // The host validates settings against the table before create; a host that does not
+    // (or a caller of the C table) gets the same refusal here.
+    static void checkAgainstTable(const binocle::sdk::Params &p) {
+        for (const binocle_param_desc &d : parameters()) {
+            const std::string key = d.name;
+            if (d.type == BINOCLE_PARAM_INT) {
+                const int64_t v = p.integer(key);
+                const std::string text = std::to_string(v);
+                if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) refuse(key + " = " + text + ": expected a value >= " + number(d.min));
+                if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) refuse(key + " = " + text + ": expected a value <= " + number(d.max));
+                if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) refuse(key + " = " + text + ": expected an odd number");
+                if (d.multiple_of > 0 && v % d.multiple_of != 0)
+                    refuse(key + " = " + text + ": expected a multiple of " + std::to_string(d.multiple_of));
+            } else if (d.type == BINOCLE_PARAM_ENUM) {
+                const std::string v = p.string(key);
+                if (v.empty() || v.find('|') != std::string::npos ||
+                    (std::string("|") + d.choices + "|").find("|" + v + "|") == std::string::npos)
+                    refuse(key + " = '" + v + "': expected one of " + d.choices);
+            }
+        }
+    }
+
+    static const sgm::Kernels &kernelsOf(const std::string &name) {
+        if (name == "scalar") return sgm::scalarKernels();
+        if (name == "baseline") {
+            if (const sgm::Kernels *k = sgm::baselineKernels()) return *k;
+            refuse("kernels = 'baseline': this build has no SIMD for this CPU's baseline; expected auto or scalar");
+        }
+        if (name == "avx2") {
+            if (const sgm::Kernels *k = sgm::avx2Kernels()) return *k;
+            refuse("kernels = 'avx2': this CPU or this build has no AVX2; expected auto, baseline or scalar");
+        }
+        return sgm::bestKernels();
+    }
+
+    // The ABI's promises (matcher.h), checked: a host never sends anything else.
+    static void checkImages(const binocle_image &left, const binocle_image &right, const binocle_image &disparity) {
+        if (left.format != BINOCLE_PIXEL_GRAY8 && left.format != BINOCLE_PIXEL_BGR8 && left.format != BINOCLE_PIXEL_RGB8)
+            refuse("left image is " + formatName(left.format) + ": expected GRAY8, BGR8 or RGB8");
+        if (right.format != left.format)
+            refuse("right image is " + formatName(right.format) + ": expected " + formatName(left.format) + ", the left image's format");
+        if (right.width != left.width || right.height != left.height)
+            refuse("right image is " + sizeText(right) + ": expected " + sizeText(left) + ", the left image's size");
+        if (disparity.format != BINOCLE_PIXEL_FLOAT32)
+            refuse("disparity image is " + formatName(disparity.format) + ": expected FLOAT32");
+        if (disparity.width != left.width || disparity.height != left.height)
+            refuse("disparity image is " + sizeText(disparity) + ": expected " + sizeText(left) + ", the left image's size");
+        const std::pair<const binocle_image *, const char *> all[] = {{&left, "left"}, {&right, "right"}, {&disparity, "disparity"}};
+        for (const auto &[im, role] : all) {
+            if (im->width <= 0 || im->height <= 0) refuse(std::string(role) + " image is " + sizeText(*im) + ": expected a positive size");
+            if (!im->data) refuse(std::string(role) + " image has no pixels (data is NULL)");
+            const int64_t row = static_cast<int64_t>(im->width) * binocle::sdk::bytesPerPixel(im->format);
+            if (im->stride_bytes < row)
+                refuse(std::string(role) + " image stride is " + std::to_string(im->stride_bytes) + " bytes: expected at least " +
+                       std::to_string(row) + " (width x bytes per pixel)");
+        }
+    }
+
+    // 8-bit grey: a view of the pixels when already GRAY8, else converted into `buffer`.
+    static cv::Mat grey(const binocle_image &im, cv::Mat &buffer) {
+        if (im.format == BINOCLE_PIXEL_GRAY8)
+            return cv::Mat(im.height, im.width, CV_8UC1, im.data, static_cast<size_t>(im.stride_bytes));
+        const cv::Mat colour(im.height, im.width, CV_8UC3, im.data, static_cast<size_t>(im.stride_bytes));
+        cv::cvtColor(colour, buffer, im.format == BINOCLE_PIXEL_RGB8 ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
+        return buffer;
+    }
+
+    std::unique_ptr<sgm::Engine> engine_;
+    cv::Mat greyLeft_, greyRight_;
+    int minDisparity_ = 0, numDisparities_ = 0;
+};
+
+} // namespace
+
+BINOCLE_EXPORT_MATCHER(SgmMatcher, "sgm", "1.0.0",
+                       "census + semi-global matching (4, 5 or 8 paths), SIMD through OpenCV's universal intrinsics")

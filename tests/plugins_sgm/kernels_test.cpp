@@ -1,0 +1,249 @@
+// SPDX-License-Identifier: MIT
+// sgm kernels: every SIMD table (baseline, AVX2 where the CPU has it) equals the scalar
+// reference bit for bit, kernel by kernel and on whole pairs: random inputs, odd sizes,
+// widths that are no whole number of vectors.
+#include "sgm_engine.hpp"
+#include "sgm_kernels.hpp"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using sgm::Kernels;
+
+// The SIMD tables this build and CPU have, by name (a stable test name).
+std::vector<std::string> simdTables() {
+    std::vector<std::string> t;
+    if (sgm::baselineKernels()) t.push_back("baseline");
+    if (sgm::avx2Kernels()) t.push_back("avx2");
+    return t;
+}
+
+class SimdKernels : public ::testing::TestWithParam<std::string> {
+protected:
+    const Kernels &simd() const { return GetParam() == "avx2" ? *sgm::avx2Kernels() : *sgm::baselineKernels(); }
+    const Kernels &ref() const { return sgm::scalarKernels(); }
+    std::mt19937_64 rng{20};
+    uint8_t byte() { return static_cast<uint8_t>(rng()); }
+};
+
+const int kWidths[] = {1, 2, 7, 15, 16, 17, 31, 33, 63, 65, 97, 130};
+
+TEST_P(SimdKernels, CensusEqualsTheReference) {
+    const std::pair<int, int> windows[] = {{3, 3}, {5, 5}, {9, 7}, {7, 9}, {11, 5}, {5, 3}};
+    for (int width : kWidths)
+        for (auto [cw, ch] : windows) {
+            cv::Mat padded(ch, width + cw - 1, CV_8UC1);
+            cv::randu(padded, 0, 256);
+            // Flat patches too: equal neighbours must not set a bit.
+            padded(cv::Rect(0, 0, std::min(3, padded.cols), ch)).setTo(7);
+            std::vector<const uint8_t *> rows(static_cast<size_t>(ch));
+            for (int j = 0; j < ch; ++j) rows[static_cast<size_t>(j)] = padded.ptr<uint8_t>(j) + cw / 2;
+            std::vector<uint64_t> a(static_cast<size_t>(width), 1), b(static_cast<size_t>(width), 2);
+            ref().censusRow(rows.data(), width, cw, ch, a.data());
+            simd().censusRow(rows.data(), width, cw, ch, b.data());
+            ASSERT_EQ(a, b) << "width " << width << ", window " << cw << "x" << ch;
+        }
+}
+
+TEST_P(SimdKernels, CostsEqualTheReference) {
+    for (int width : kWidths)
+        for (int minD : {0, 3, 17})
+            for (int numDisp : {16, 48, 64, 128, 256}) {
+                const int dp = sgm::paddedDisparities(numDisp);
+                std::vector<uint64_t> left(static_cast<size_t>(width)), right(static_cast<size_t>(width));
+                for (auto &v : left) v = rng() & ((uint64_t(1) << 62) - 1);
+                for (auto &v : right) v = rng();
+                std::vector<uint64_t> scratch(simd().costScratchWords(width, minD, dp) + 1);
+                std::vector<uint8_t> a(static_cast<size_t>(width) * dp, 1), b(static_cast<size_t>(width) * dp, 2);
+                ref().costRow(left.data(), right.data(), width, minD, numDisp, dp, nullptr, a.data());
+                simd().costRow(left.data(), right.data(), width, minD, numDisp, dp, scratch.data(), b.data());
+                ASSERT_EQ(a, b) << "width " << width << ", min_disparity " << minD << ", num_disparities " << numDisp;
+            }
+}
+
+// Random costs (with invalid ones), random predecessors with their sentinels, penalties
+// by intensity step; both kernels must write the same path costs, minima and sums.
+struct PathCase {
+    int width, dp;
+    std::vector<uint8_t> cost, prevL, prevMin, grey, greyPrev, lut;
+    std::vector<uint16_t> sum;
+};
+
+PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2) {
+    PathCase c;
+    c.width = width;
+    c.dp = sgm::paddedDisparities(numDisp);
+    const size_t stride = sgm::pathStride(c.dp);
+    c.cost.resize(static_cast<size_t>(width) * c.dp);
+    for (auto &v : c.cost) v = rng() % 8 == 0 ? sgm::kCostInvalid : static_cast<uint8_t>(rng() % 63);
+    c.prevL.assign(static_cast<size_t>(width) * stride, sgm::kCostInvalid);
+    c.prevMin.resize(static_cast<size_t>(width));
+    for (int x = 0; x < width; ++x) {
+        uint8_t least = 255;
+        for (int d = 0; d < c.dp; ++d) {
+            const uint8_t v = static_cast<uint8_t>(rng() % 200);
+            c.prevL[x * stride + 1 + d] = v;
+            least = std::min(least, v);
+        }
+        c.prevMin[static_cast<size_t>(x)] = least;
+    }
+    c.grey.resize(static_cast<size_t>(width));
+    c.greyPrev.resize(static_cast<size_t>(width));
+    for (auto &v : c.grey) v = static_cast<uint8_t>(rng());
+    for (auto &v : c.greyPrev) v = static_cast<uint8_t>(rng());
+    c.lut.resize(256);
+    for (int g = 0; g < 256; ++g) c.lut[static_cast<size_t>(g)] = static_cast<uint8_t>(std::max(p1, p2 * 16 / (16 + g)));
+    c.sum.resize(static_cast<size_t>(width) * c.dp);
+    for (auto &v : c.sum) v = static_cast<uint16_t>(rng() % 1500);
+    return c;
+}
+
+TEST_P(SimdKernels, PathsEqualTheReference) {
+    // Path sets as the engine runs them: one vertical, three from above, and others.
+    const std::vector<std::vector<int>> sets = {{0}, {-1, 0, 1}, {1}, {-1}, {1, -1}};
+    for (int width : kWidths)
+        for (int numDisp : {16, 64, 96, 256})
+            for (const std::vector<int> &dxs : sets)
+                for (bool first : {false, true})
+                    for (bool init : {false, true}) {
+                        const int n = static_cast<int>(dxs.size());
+                        std::vector<PathCase> cases;
+                        const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
+                        for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2));
+                        const PathCase &c = cases[0];
+                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const size_t rowBytes = static_cast<size_t>(width) * sgm::pathStride(c.dp);
+                        std::vector<std::vector<uint8_t>> la(3, std::vector<uint8_t>(rowBytes, sgm::kCostInvalid)), lb = la;
+                        std::vector<std::vector<uint8_t>> ma(3, std::vector<uint8_t>(static_cast<size_t>(width))), mb = ma;
+                        sgm::RowPaths ra{}, rb{};
+                        ra.count = rb.count = n;
+                        for (int i = 0; i < n; ++i) {
+                            ra.dx[i] = rb.dx[i] = dxs[static_cast<size_t>(i)];
+                            ra.prevL[i] = rb.prevL[i] = first ? nullptr : cases[static_cast<size_t>(i)].prevL.data();
+                            ra.prevMin[i] = rb.prevMin[i] = cases[static_cast<size_t>(i)].prevMin.data();
+                            ra.curL[i] = la[static_cast<size_t>(i)].data();
+                            rb.curL[i] = lb[static_cast<size_t>(i)].data();
+                            ra.curMin[i] = ma[static_cast<size_t>(i)].data();
+                            rb.curMin[i] = mb[static_cast<size_t>(i)].data();
+                        }
+                        std::vector<uint16_t> sa = c.sum, sb = c.sum;
+                        ref().pathRow(c.cost.data(), width, c.dp, ra, c.grey.data(), c.greyPrev.data(), pp, sa.data(), init);
+                        simd().pathRow(c.cost.data(), width, c.dp, rb, c.grey.data(), c.greyPrev.data(), pp, sb.data(), init);
+                        const std::string what = "width " + std::to_string(width) + ", num_disparities " +
+                                                 std::to_string(numDisp) + ", paths " + std::to_string(n);
+                        ASSERT_EQ(la, lb) << what;
+                        ASSERT_EQ(ma, mb) << what;
+                        ASSERT_EQ(sa, sb) << what;
+
+                        std::vector<uint8_t> scratch(2 * sgm::pathStride(c.dp), sgm::kCostInvalid);
+                        sa = c.sum;
+                        sb = c.sum;
+                        ref().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sa.data(), init);
+                        simd().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sb.data(), init);
+                        ASSERT_EQ(sa, sb) << "horizontal, " << what;
+                    }
+}
+
+TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
+    for (int width : kWidths)
+        for (int numDisp : {16, 48, 64, 256})
+            for (int minD : {0, 5})
+                for (int uniqueness : {0, 5, 15, 60})
+                    for (bool subpixel : {false, true})
+                        for (int range : {4, 2000}) { // small ranges: many ties
+                            const int dp = sgm::paddedDisparities(numDisp);
+                            std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
+                            for (auto &v : sum) v = static_cast<uint16_t>(rng() % range);
+                            const sgm::WtaParams wp{minD, numDisp, dp, uniqueness, subpixel};
+                            std::vector<int16_t> ba(static_cast<size_t>(width)), bb(static_cast<size_t>(width));
+                            std::vector<uint16_t> sa(static_cast<size_t>(width)), sb(static_cast<size_t>(width));
+                            std::vector<uint16_t> da(static_cast<size_t>(width)), db(static_cast<size_t>(width));
+                            ref().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
+                            simd().wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
+                            const std::string what = "width " + std::to_string(width) + ", num_disparities " +
+                                                     std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
+                            ASSERT_EQ(ba, bb) << what;
+                            ASSERT_EQ(sa, sb) << what;
+                            ASSERT_EQ(da, db) << what;
+                        }
+}
+
+// A textured pair with a step in depth, at an odd size.
+std::pair<cv::Mat, cv::Mat> texturedPair(cv::Size size, uint64_t seed) {
+    cv::Mat texture(size.height, size.width + 40, CV_8UC1);
+    cv::RNG r(seed);
+    r.fill(texture, cv::RNG::UNIFORM, 0, 256);
+    cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
+    cv::Mat left = texture.colRange(0, size.width).clone();
+    cv::Mat right = texture.colRange(12, 12 + size.width).clone();
+    // A nearer square: 25 px.
+    const cv::Rect box(size.width / 3, size.height / 4, size.width / 3, size.height / 2);
+    texture(cv::Rect(box.x + 25, box.y, box.width, box.height)).copyTo(left(box));
+    return {left, right};
+}
+
+TEST_P(SimdKernels, WholePairsEqualTheReference) {
+    const auto [left, right] = texturedPair({123, 77}, 3);
+    for (int paths : {4, 5, 8})
+        for (int stripes : {1, 3}) {
+            sgm::Settings s;
+            s.numDisparities = 48;
+            s.minDisparity = 2;
+            s.paths = paths;
+            s.stripes = stripes;
+            s.p2IntensityStep = paths == 8 ? 24 : 0;
+            sgm::Engine a(s, sgm::scalarKernels()), b(s, simd());
+            const cv::Mat fa = a.computeFixed(left, right).clone();
+            const cv::Mat fb = b.computeFixed(left, right);
+            EXPECT_EQ(cv::countNonZero(fa != fb), 0) << "paths " << paths << ", stripes " << stripes;
+            EXPECT_GT(cv::countNonZero(fa), left.total() / 2) << "paths " << paths;
+        }
+}
+
+INSTANTIATE_TEST_SUITE_P(Tables, SimdKernels, ::testing::ValuesIn(simdTables()),
+                         [](const ::testing::TestParamInfo<std::string> &i) { return i.param; });
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SimdKernels);
+
+// Buffers are made for the first pair of a size and reused for every later one.
+TEST(SgmEngine, AllocatesOncePerImageSize) {
+    const auto [left, right] = texturedPair({160, 96}, 4);
+    sgm::Engine e(sgm::Settings{}, sgm::bestKernels());
+    cv::Mat d(left.size(), CV_32FC1);
+    for (int i = 0; i < 3; ++i) e.compute(left, right, d, -1.0f);
+    EXPECT_EQ(e.allocations(), 1);
+    const auto [l2, r2] = texturedPair({161, 97}, 4);
+    cv::Mat d2(l2.size(), CV_32FC1);
+    e.compute(l2, r2, d2, -1.0f);
+    EXPECT_EQ(e.allocations(), 2);
+}
+
+// The volume of 4 and 8 paths is bounded: refused, with the figures, before any buffer.
+TEST(SgmEngine, RefusesAPairOverTheMemoryBound) {
+    sgm::Settings s;
+    s.numDisparities = 256;
+    s.maxMemoryBytes = 64.0 * 1048576;
+    sgm::Engine e(s, sgm::bestKernels());
+    const cv::Mat big(1000, 1200, CV_8UC1, cv::Scalar(0));
+    try {
+        e.computeFixed(big, big);
+        FAIL() << "no refusal";
+    } catch (const std::invalid_argument &ex) {
+        const std::string m = ex.what();
+        EXPECT_NE(m.find("1200x1000"), std::string::npos) << m;
+        EXPECT_NE(m.find("max_memory_mb = 64"), std::string::npos) << m;
+        EXPECT_NE(m.find("paths 5"), std::string::npos) << m;
+    }
+    EXPECT_EQ(e.allocations(), 0);
+    s.paths = 5; // no volume: fits
+    sgm::Engine five(s, sgm::bestKernels());
+    EXPECT_NO_THROW(five.computeFixed(big, big));
+}
+
+} // namespace
