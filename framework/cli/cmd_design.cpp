@@ -294,8 +294,13 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
                   app.add_option("--num-disparities", a->head.num_disparities, "the matcher's disparity search (default 64)")
                       ->type_name("N")
                       ->check(atLeast(1));
-                  app.add_option("--camera-height-mm", a->head.camera_height_mm, "camera height (default " + num(method::kDefaultCameraHeightMm) + ")")->type_name("MM");
-                  app.add_option("--inclination-deg", a->head.inclination_deg, "inclination (default 0)")->type_name("DEG")->check(CLI::Range(-89.0, 89.0));
+                  app.add_option("--camera-height-mm", a->head.camera_height_mm, "camera height (default " + num(method::kDefaultCameraHeightMm) + ")")
+                      ->type_name("MM")
+                      ->check(decimalNumber());
+                  app.add_option("--inclination-deg", a->head.inclination_deg, "inclination (default 0)")
+                      ->type_name("DEG")
+                      ->check(decimalNumber())
+                      ->check(CLI::Range(-89.0, 89.0));
                   app.add_option("--panel-width-mm", a->panel_width_mm, "width of the object that must fit (default 2500)")
                       ->type_name("MM")
                       ->check(positiveNumber());

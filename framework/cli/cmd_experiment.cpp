@@ -85,7 +85,8 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
                   app.add_option("--shard", args->shard,
                                  "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
                                  "shards with `binocle experiment merge OUT DIR...`")
-                      ->type_name("K/N");
+                      ->type_name("K/N")
+                      ->check(wholeNumbers('/', 1));
                   auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
                                                         "one unsharded run (timings apart)");
                   m->add_option("folders", args->merge, "OUT DIR...")->required()->expected(2, -1);

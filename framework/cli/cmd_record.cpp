@@ -106,6 +106,7 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
                   app.add_option("--png-compression", args->png_compression,
                                  "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
                       ->type_name("L")
+                      ->check(wholeNumber())
                       ->check(CLI::Range(0, 9));
                   app.add_option("--writer-threads", args->writer_threads,
                                  "threads that encode and write images (default: two per core, 4..16)")

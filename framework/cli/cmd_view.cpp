@@ -56,7 +56,7 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                   addRigArgs(app, args->rig);
                   app.add_option("--port", args->options.port, "TCP port (0: any free port)")
                       ->type_name("N")
-                      ->check(CLI::Range(0, 65535))
+                      ->check(wholeNumberIn(0, 65535))
                       ->capture_default_str();
                   app.add_option("--bind", args->options.address, "address to listen on (an IP address)")
                       ->type_name("ADDR")

@@ -16,6 +16,7 @@
 
 #include <binocle/plugin.hpp>
 #include <binocle/recording.hpp>
+#include <binocle/settings.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -88,49 +89,39 @@ struct Settings {
 
 std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
 
-// Settings absent from `p` keep their defaults: a host may pass only what the YAML set.
+// The table above is the one home of each setting's default, bounds and choices: the
+// SDK's checker reads `p` against it (a setting the host did not pass is its default).
+// Only the rules it cannot state are written here.
 Settings readSettings(const sdk::Params &p) {
+    const sdk::CheckedParams c(p, parameterTable(), "replay");
     Settings s;
-    auto text = [&](const char *name, std::string &out) {
-        if (p.has(name)) out = p.string(name);
-    };
     // An unset PATH is empty whatever the host made of the empty default.
     auto path = [&](const char *name, std::string &out) {
-        if (p.has(name) && p.isExplicit(name)) out = p.string(name);
+        if (c.isExplicit(name)) out = c.string(name);
     };
-    text("layout", s.layout);
+    s.layout = c.string("layout");
     path("left", s.left);
     path("right", s.right);
     path("ground_truth", s.groundTruth);
     path("folder", s.folder);
     path("calibration", s.calibration);
-    if (p.has("ground_truth_scale")) s.groundTruthScale = p.real("ground_truth_scale");
-    if (p.has("loop")) s.loop = p.boolean("loop");
-    if (p.has("first_frame")) s.firstFrame = p.integer("first_frame");
-    if (p.has("max_frames")) s.maxFrames = p.integer("max_frames");
-    std::string color = "bgr";
-    text("color", color);
-    if (p.has("rate_hz")) s.rateHz = p.real("rate_hz");
+    s.groundTruthScale = c.real("ground_truth_scale");
+    s.loop = c.boolean("loop");
+    s.firstFrame = c.integer("first_frame");
+    s.maxFrames = c.integer("max_frames");
+    s.gray = c.string("color") == "gray";
+    s.rateHz = c.real("rate_hz");
     path("bag", s.bag.bag);
-    text("left_topic", s.bag.leftTopic);
-    text("right_topic", s.bag.rightTopic);
-    if (p.has("pair_tolerance_ms")) s.bag.pairToleranceMs = p.real("pair_tolerance_ms");
-    if (p.has("start_s")) s.bag.startS = p.real("start_s");
-    if (p.has("duration_s")) s.bag.durationS = p.real("duration_s");
-
-    auto refuse = [](const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what); };
-    const std::string layouts = "|auto|glob|middlebury|kitti|recording|mcap|";
-    if (s.layout.empty() || layouts.find("|" + s.layout + "|") == std::string::npos)
-        refuse("layout '" + s.layout + "': expected one of auto, glob, middlebury, kitti, recording, mcap");
-    if (color != "gray" && color != "bgr") refuse("color '" + color + "': expected gray or bgr");
-    s.gray = color == "gray";
-    if (!(s.groundTruthScale > 0) || !std::isfinite(s.groundTruthScale))
-        refuse("ground_truth_scale " + std::to_string(s.groundTruthScale) + ": expected a number > 0");
-    if (s.firstFrame < 0) refuse("first_frame " + std::to_string(s.firstFrame) + ": expected >= 0");
-    if (s.maxFrames < 0) refuse("max_frames " + std::to_string(s.maxFrames) + ": expected >= 0 (0 = all)");
+    if (c.isExplicit("left_topic")) s.bag.leftTopic = c.string("left_topic");
+    if (c.isExplicit("right_topic")) s.bag.rightTopic = c.string("right_topic");
+    s.bag.pairToleranceMs = c.real("pair_tolerance_ms");
+    s.bag.startS = c.real("start_s");
+    s.bag.durationS = c.real("duration_s");
+    if (!(s.groundTruthScale > 0))
+        c.refuse("ground_truth_scale", sdk::settingNumberText(s.groundTruthScale), "a number > 0");
     // Below 1 mHz the frame period (ns) would not fit 64 bits.
-    if (!(s.rateHz >= 0) || !std::isfinite(s.rateHz) || (s.rateHz > 0 && s.rateHz < 1e-3))
-        refuse("rate_hz " + std::to_string(s.rateHz) + ": expected 0 (as fast as possible) or a rate >= 0.001 Hz");
+    if (s.rateHz > 0 && s.rateHz < 1e-3)
+        c.refuse("rate_hz", sdk::settingNumberText(s.rateHz), "0 (as fast as possible) or a rate >= 0.001 Hz");
     return s;
 }
 
