@@ -112,103 +112,78 @@ struct CalibrateArgs {
     double still_px = 1.0;
 };
 
-int calibrate(const CalibrateArgs &args, const CLI::App &app) {
-    // Every input is checked before anything is read or written.
-    const bool pairsGiven = app.count("--pairs") > 0;
-    CalibrationOptions options = args.options;
-    try {
-        options.board = BoardSpec::parse(args.board, *args.square_mm);
-    } catch (const Error &e) {
-        throw UsageError(e.what());
+// Pairs from a folder of left<N>/right<N> images, each screened as it is added.
+void pairsFromFolder(StereoCalibrator &calibrator, const std::string &pairsDir, const CalibrationOptions &options,
+                     const std::string &boardText) {
+    const PairListing listing = listImagePairs(pairsDir);
+    for (const auto &u : listing.unmatched) spdlog::info("  ignored {}", u);
+    if (listing.pairs.empty())
+        throw Error("--pairs " + pairsDir + ": no image pairs found (expected left<N>.png|jpg with right<N>.png|jpg, e.g. "
+                    "left01.jpg and right01.jpg)");
+    spdlog::info("binocle calibrate: {} board, {} mm squares, {} pair(s) in {}", boardText, options.board.square_mm,
+                 listing.pairs.size(), pairsDir);
+    for (const auto &pair : listing.pairs) {
+        const cv::Mat l = cv::imread(pair.left, cv::IMREAD_GRAYSCALE), r = cv::imread(pair.right, cv::IMREAD_GRAYSCALE);
+        const PairRecord &rec = l.empty() || r.empty()
+                                    ? calibrator.addRejected(pair.id, "cannot read " + (l.empty() ? pair.left : pair.right) +
+                                                                          " as an image", pair.left, pair.right)
+                                    : calibrator.addPair(pair.id, l, r, pair.left, pair.right);
+        printScreened(rec);
     }
-    if (!(options.max_pair_error_px > 0)) throw UsageError("--max-pair-error-px: expected a value > 0");
-    const bool live = args.live;
-    const std::string pairsDir = args.pairs;
-    if (live && pairsGiven) throw UsageError("--pairs and --live exclude each other: pairs come from a folder or from the rig's source");
-    if (pairsGiven && pairsDir.empty()) throw UsageError("--pairs: expected a folder");
-    if (args.rig.file.empty() && !pairsGiven)
-        throw UsageError("expected a rig file (its source delivers the pairs) or --pairs DIR");
-    const long long wanted = args.pairs_wanted.value_or(live ? 12 : -1);
-    const long long maxFrames = args.frames;
-    const long long stillFrames = args.still_frames;
-    const double stillPx = args.still_px;
-    if (args.pairs_wanted && wanted < options.min_pairs)
-        throw UsageError("--pairs-wanted " + std::to_string(wanted) + ": expected at least --min-pairs (" +
-                         std::to_string(options.min_pairs) + ")");
+}
 
-    std::optional<RigConfig> rig;
-    std::optional<PluginHost> host;
-    StatedGeometry stated;
-    if (!args.rig.file.empty()) {
-        host.emplace();
-        // No scan: the rig opens only the plugins it names.
-        rig = loadRig(args.rig, *host);
-        stated = statedGeometry(rig->source);
-    } else if (!args.rig.overrides.empty()) {
-        throw UsageError("--set changes a rig, but no rig file was given");
-    }
-    const double pixelPitchUm = args.pixel_pitch_um.value_or(stated.pixel_pitch_um.value_or(0));
-    const std::string out = args.out;
-    if (app.count("--out") && out.empty()) throw UsageError("--out: expected a file name");
+// How pairs are taken from a source.
+struct SourcePairs {
+    bool live = false;           // only when the board has been still (StillBoard)
+    long long wanted = -1;       // good pairs to stop at; < 0: every frame
+    long long maxFrames = -1;    // frames to read at most; < 0: until the source ends
+    long long stillFrames = 5;
+    double stillPx = 1.0;
+};
 
-    StereoCalibrator calibrator(options);
-    const std::string boardText = std::to_string(options.board.cols) + "x" + std::to_string(options.board.rows);
-    if (pairsGiven) {
-        const PairListing listing = listImagePairs(pairsDir);
-        for (const auto &u : listing.unmatched) spdlog::info("  ignored {}", u);
-        if (listing.pairs.empty())
-            throw Error("--pairs " + pairsDir + ": no image pairs found (expected left<N>.png|jpg with right<N>.png|jpg, e.g. "
-                        "left01.jpg and right01.jpg)");
-        spdlog::info("binocle calibrate: {} board, {} mm squares, {} pair(s) in {}", boardText, options.board.square_mm,
-                     listing.pairs.size(), pairsDir);
-        for (const auto &pair : listing.pairs) {
-            const cv::Mat l = cv::imread(pair.left, cv::IMREAD_GRAYSCALE), r = cv::imread(pair.right, cv::IMREAD_GRAYSCALE);
-            const PairRecord &rec = l.empty() || r.empty()
-                                        ? calibrator.addRejected(pair.id, "cannot read " + (l.empty() ? pair.left : pair.right) +
-                                                                              " as an image", pair.left, pair.right)
-                                        : calibrator.addPair(pair.id, l, r, pair.left, pair.right);
+// Pairs from the rig's source: every frame, or (live) those where the board is still.
+void pairsFromSource(StereoCalibrator &calibrator, const RigConfig &rig, const SourcePairs &how, const CalibrationOptions &options,
+                     const std::string &boardText) {
+    Source source(*rig.source.record, rig.source.params);
+    spdlog::info("binocle calibrate: {} board, {} mm squares, pairs from source '{}'{}", boardText, options.board.square_mm,
+                 rig.source.plugin,
+                 how.live ? " (live: a pair is taken when the board has been still for " + std::to_string(how.stillFrames) + " frames)"
+                          : "");
+    source.start();
+    StillBoard still(static_cast<int>(how.stillFrames), how.stillPx, 20.0);
+    // The frame count and the board's state; the screened pairs are logged above it.
+    Progress progress(how.live, "frame", how.maxFrames);
+    long long frames = 0;
+    while ((how.maxFrames < 0 || frames < how.maxFrames) && (how.wanted < 0 || calibrator.goodPairs() < how.wanted)) {
+        std::unique_ptr<LentFrame> frame = source.grab(5000);
+        if (!frame) break;
+        ++frames;
+        const std::string id = std::to_string(frame->raw().sequence);
+        const auto [leftFile, rightFile] = filesOf(*frame);
+        if (!how.live) {
+            printScreened(calibrator.addPair(id, frame->left(), frame->right(), leftFile, rightFile));
+            continue;
+        }
+        BoardView l = findBoard(frame->left(), options.board, true), r = findBoard(frame->right(), options.board, true);
+        if (still.update(l, r)) {
+            const PairRecord &rec = calibrator.addViews(id, frame->left().size(), std::move(l), std::move(r), leftFile, rightFile);
             printScreened(rec);
         }
-    } else {
-        Source source(*rig->source.record, rig->source.params);
-        spdlog::info("binocle calibrate: {} board, {} mm squares, pairs from source '{}'{}", boardText, options.board.square_mm,
-                     rig->source.plugin,
-                     live ? " (live: a pair is taken when the board has been still for " + std::to_string(stillFrames) + " frames)" : "");
-        source.start();
-        StillBoard still(static_cast<int>(stillFrames), stillPx, 20.0);
-        // The frame count and the board's state; the screened pairs are logged above it.
-        Progress progress(live, "frame", maxFrames);
-        long long frames = 0;
-        while ((maxFrames < 0 || frames < maxFrames) && (wanted < 0 || calibrator.goodPairs() < wanted)) {
-            std::unique_ptr<LentFrame> frame = source.grab(5000);
-            if (!frame) break;
-            ++frames;
-            const std::string id = std::to_string(frame->raw().sequence);
-            const auto [leftFile, rightFile] = filesOf(*frame);
-            if (!live) {
-                printScreened(calibrator.addPair(id, frame->left(), frame->right(), leftFile, rightFile));
-                continue;
-            }
-            BoardView l = findBoard(frame->left(), options.board, true), r = findBoard(frame->right(), options.board, true);
-            if (still.update(l, r)) {
-                const PairRecord &rec = calibrator.addViews(id, frame->left().size(), std::move(l), std::move(r), leftFile, rightFile);
-                printScreened(rec);
-            }
-            progress.update(frames, std::to_string(calibrator.goodPairs()) + (wanted > 0 ? "/" + std::to_string(wanted) : "") +
-                                        " good pairs, board " +
-                                        (l.found || r.found ? "still for " + std::to_string(still.stillFrames()) + " frame(s)"
-                                                            : "not in view"));
-        }
-        progress.finish();
-        source.stop();
-        if (calibrator.pairs().empty()) throw Error("source '" + rig->source.plugin + "' delivered no pair to calibrate with");
+        progress.update(frames, std::to_string(calibrator.goodPairs()) + (how.wanted > 0 ? "/" + std::to_string(how.wanted) : "") +
+                                    " good pairs, board " +
+                                    (l.found || r.found ? "still for " + std::to_string(still.stillFrames()) + " frame(s)"
+                                                        : "not in view"));
     }
+    progress.finish();
+    source.stop();
+    if (calibrator.pairs().empty()) throw Error("source '" + rig.source.plugin + "' delivered no pair to calibrate with");
+}
 
-    CalibrationResult result = calibrator.calibrate();
+// Names the calibration after its configuration (what the rig states, else what was
+// recovered), warns where the two disagree, and writes it with its companions.
+void writeResult(CalibrationResult &result, const CalibrationOptions &options, const StatedGeometry &stated, double pixelPitchUm,
+                 const std::string &out) {
     StereoCalibration &c = result.calibration;
-    printSummary(result, options.board.square_mm, pixelPitchUm);
-
-    // Named after the configuration: what the rig states, else what was recovered.
     const double fx = c.M1.at<double>(0, 0);
     std::optional<double> focalMm = stated.focal_length_mm;
     if (!focalMm && pixelPitchUm > 0) focalMm = fx * pixelPitchUm / 1000.0;
@@ -232,6 +207,54 @@ int calibrate(const CalibrateArgs &args, const CLI::App &app) {
     spdlog::info("  wrote {} (configuration {}), {}, {}, {}", files.calibration, c.configuration, baseName(files.left_info),
                  baseName(files.right_info), baseName(files.report));
     std::cout << files.calibration << "\n";
+}
+
+int calibrate(const CalibrateArgs &args, const CLI::App &app) {
+    // Every input is checked before anything is read or written.
+    const bool pairsGiven = app.count("--pairs") > 0;
+    CalibrationOptions options = args.options;
+    try {
+        options.board = BoardSpec::parse(args.board, *args.square_mm);
+    } catch (const Error &e) {
+        throw UsageError(e.what());
+    }
+    if (!(options.max_pair_error_px > 0)) throw UsageError("--max-pair-error-px: expected a value > 0");
+    if (args.live && pairsGiven) throw UsageError("--pairs and --live exclude each other: pairs come from a folder or from the rig's source");
+    if (pairsGiven && args.pairs.empty()) throw UsageError("--pairs: expected a folder");
+    if (args.rig.file.empty() && !pairsGiven)
+        throw UsageError("expected a rig file (its source delivers the pairs) or --pairs DIR");
+    SourcePairs how;
+    how.live = args.live;
+    how.wanted = args.pairs_wanted.value_or(args.live ? 12 : -1);
+    how.maxFrames = args.frames;
+    how.stillFrames = args.still_frames;
+    how.stillPx = args.still_px;
+    if (args.pairs_wanted && how.wanted < options.min_pairs)
+        throw UsageError("--pairs-wanted " + std::to_string(how.wanted) + ": expected at least --min-pairs (" +
+                         std::to_string(options.min_pairs) + ")");
+
+    std::optional<RigConfig> rig;
+    std::optional<PluginHost> host;
+    StatedGeometry stated;
+    if (!args.rig.file.empty()) {
+        host.emplace();
+        // No scan: the rig opens only the plugins it names.
+        rig = loadRig(args.rig, *host);
+        stated = statedGeometry(rig->source);
+    } else if (!args.rig.overrides.empty()) {
+        throw UsageError("--set changes a rig, but no rig file was given");
+    }
+    const double pixelPitchUm = args.pixel_pitch_um.value_or(stated.pixel_pitch_um.value_or(0));
+    if (app.count("--out") && args.out.empty()) throw UsageError("--out: expected a file name");
+
+    StereoCalibrator calibrator(options);
+    const std::string boardText = std::to_string(options.board.cols) + "x" + std::to_string(options.board.rows);
+    if (pairsGiven) pairsFromFolder(calibrator, args.pairs, options, boardText);
+    else pairsFromSource(calibrator, *rig, how, options, boardText);
+
+    CalibrationResult result = calibrator.calibrate();
+    printSummary(result, options.board.square_mm, pixelPitchUm);
+    writeResult(result, options, stated, pixelPitchUm, args.out);
     return 0;
 }
 
@@ -260,13 +283,15 @@ Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm
                   app.add_option("--board", a->board, "inner corners per row and per column, e.g. 9x6")->type_name("COLSxROWS")->required();
                   app.add_option("--square-mm", a->square_mm, "side of one square in mm (the baseline scales with it)")
                       ->type_name("S")
-                      ->required();
+                      ->required()
+                      ->check(decimalNumber());
                   app.add_option("--pairs", a->pairs, "image pairs left<N>.png|jpg and right<N>.* in this folder")->type_name("DIR");
                   app.add_flag("--live", a->live, "pairs from the rig's source, taken when the board is still");
                   app.add_option("--out", a->out, "the calibration file (default: calib_<configuration>.yml here); an existing folder: that file in it")
                       ->type_name("FILE");
                   app.add_option("--pairs-wanted", a->pairs_wanted, "stop after N good pairs (default 12 with --live, else all frames)")
-                      ->type_name("N");
+                      ->type_name("N")
+                      ->check(wholeNumber());
                   app.add_option("--frames", a->frames, "read at most N frames from the source")->type_name("N")->check(atLeast(1));
                   app.add_option("--still-frames", a->still_frames, "live: frames the board must be still (default 5)")
                       ->type_name("N")
@@ -279,12 +304,15 @@ Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm
                       ->check(positiveNumber());
                   app.add_option("--min-board-percent", a->options.min_board_area_percent,
                                  "reject boards covering less of the image (default 1.5)")
-                      ->type_name("A");
+                      ->type_name("A")
+                      ->check(decimalNumber());
                   app.add_option("--max-edge-width-px", a->options.max_edge_width_px, "reject blurred boards, edges wider than W px (default 4)")
-                      ->type_name("W");
+                      ->type_name("W")
+                      ->check(decimalNumber());
                   app.add_option("--max-pair-error-px", a->options.max_pair_error_px,
                                  "drop pairs with a larger reprojection error and recalibrate (default 1)")
-                      ->type_name("E");
+                      ->type_name("E")
+                      ->check(decimalNumber());
                   app.add_option("--min-pairs", a->options.min_pairs, "fewest good pairs to calibrate with (default 4)")
                       ->type_name("N")
                       ->check(atLeast(3));

@@ -18,15 +18,18 @@ struct PluginCheckArgs {
 
 int checkPluginCommand(PluginCheckArgs &args) {
     args.options.case_timeout_ms = static_cast<int32_t>(args.timeout_ms);
-    const ConformanceReport report = checkPlugin(args.options);
+    ConformanceReport report;
+    try {
+        report = checkPlugin(args.options);
+    } catch (const SettingsRefused &e) {
+        throw UsageError(e.what()); // exit status 2: no case ran with settings not meant
+    }
     static const char *words[] = {"PASS", "FAIL", "SKIP"};
     std::cout << "plugin-check " << report.path << (report.kind.empty() ? "" : " (" + report.kind + " '" + report.plugin + "')")
               << "\n";
     for (const auto &c : report.cases)
         std::cout << "  " << words[static_cast<int>(c.status)] << "  " << c.name << (c.message.empty() ? "" : ": " + c.message) << "\n";
-    using S = ConformanceCase::Status;
-    std::cout << report.count(S::Passed) << " passed, " << report.count(S::Failed) << " failed, " << report.count(S::Skipped)
-              << " skipped\n";
+    std::cout << report.summary() << "\n";
     if (!args.junit.empty()) writeFileAtomic(args.junit, junitXml(report));
     return report.passed() ? kExitOk : kExitFailed;
 }
@@ -44,7 +47,9 @@ Register reg{{"plugin-check", "check a plugin against the ABI's rules (conforman
               "  transform   apply inside the host's arrays, empty cloud\n"
               "  evaluator   evaluate on read-only guarded inputs\n"
               "A source that needs a device it cannot find has its instance cases skipped,\n"
-              "saying why. Exit status 0 when no case failed, 1 otherwise.",
+              "saying why; skipped cases are counted apart and never read as a pass.\n"
+              "Exit status 0 when no case failed, 1 otherwise, 2 for a --set the plugin\n"
+              "refuses (an unknown key or a bad value).",
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<PluginCheckArgs>();
                   app.add_option("plugin", args->options.plugin, "the plugin file (FILE.so) or name (binocle_NAME.so in the search path)")

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `binocle report DIR`: a self-contained HTML report of an experiment's results.
 #include "cli/command.hpp"
+#include "core/output_folder.hpp"
 #include "report/html_report.hpp"
 
 #include <iostream>
+#include <optional>
 
 namespace binocle::cli {
 namespace {
@@ -17,7 +19,12 @@ int report(const ReportArgs &args) {
     if (!args.output.empty() && dirs.size() > 1)
         throw UsageError("--output " + args.output + ": " + args.dir + " holds " + std::to_string(dirs.size()) +
                          " experiments; without --output each gets DIR/<experiment>/report.html");
-    for (const auto &dir : dirs) std::cout << report::writeExperimentReport(dir, args.output) << "\n";
+    for (const auto &dir : dirs) {
+        // Not into a folder an experiment still writes: its tables would be half done.
+        std::optional<OutputFolder> folder;
+        if (args.output.empty()) folder.emplace(dir, OutputClaim{OutputKind::None, false, "binocle report"});
+        std::cout << report::writeExperimentReport(dir, args.output) << "\n";
+    }
     return 0;
 }
 

@@ -3,6 +3,8 @@
 // the spirit of libcamera's lc-compliance, with a JUnit XML report for an author's CI.
 #pragma once
 
+#include "core/error.hpp"
+
 #include <string>
 #include <vector>
 
@@ -30,9 +32,22 @@ struct ConformanceReport {
     std::vector<ConformanceCase> cases;
     int count(ConformanceCase::Status s) const;
     bool passed() const { return count(ConformanceCase::Status::Failed) == 0; }
+    // True when every case ran: a skipped case checked nothing, so a report with skips
+    // is never read as a full pass.
+    bool complete() const { return count(ConformanceCase::Status::Skipped) == 0; }
+    // "3 passed, 0 failed, 6 skipped (not checked: ...)"; the line the CLI prints.
+    std::string summary() const;
 };
 
-// Runs every check that applies to the plugin's kind. Each case that calls the plugin
+// A --set the plugin refuses (unknown key, bad value): the command line is wrong, and
+// no case runs with settings the user did not mean.
+class SettingsRefused : public Error {
+public:
+    using Error::Error;
+};
+
+// Runs every check that applies to the plugin's kind. Throws SettingsRefused for a --set
+// the plugin refuses, Error when the file cannot be found. Each case that calls the plugin
 // runs in a child process, so that a crash or a hang is a failed case (with the signal
 // or the timeout), and the battery goes on.
 ConformanceReport checkPlugin(const ConformanceOptions &options);

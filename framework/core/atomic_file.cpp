@@ -4,11 +4,14 @@
 
 #include "core/error.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fcntl.h>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <unistd.h>
 
@@ -36,9 +39,24 @@ std::string readTextFile(const std::string &path, uintmax_t maxBytes) {
 
 namespace {
 
-std::string temporaryFor(const std::string &path) {
-    fs::path p(path);
-    return (p.parent_path() / (".tmp-" + std::to_string(::getpid()) + "-" + p.filename().string())).string();
+// A new, empty temporary beside `path`: ".tmp-<pid>-<random>-<file name>" (the extension
+// kept for writers that choose the format by it), created with O_EXCL | O_NOFOLLOW so that
+// a file or symlink planted under a guessed name is never followed nor reused. The mode
+// is the usual 0666 less the umask, as a plain open would give.
+int createTemporary(const std::string &path, std::string &tmp) {
+    static std::atomic<uint64_t> counter{0};
+    const fs::path p(path);
+    std::random_device random;
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        char tag[64];
+        std::snprintf(tag, sizeof tag, ".tmp-%d-%08x%04x-", static_cast<int>(::getpid()), random(),
+                      static_cast<unsigned>(counter++ & 0xffff));
+        tmp = (p.parent_path() / (tag + p.filename().string())).string();
+        const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd >= 0) return fd;
+        if (errno != EEXIST) throw Error("cannot write " + path + ": cannot create " + tmp + ": " + std::strerror(errno));
+    }
+    throw Error("cannot write " + path + ": no free temporary name beside it (100 tries)");
 }
 
 void commit(const std::string &tmp, const std::string &path) {
@@ -53,19 +71,32 @@ void commit(const std::string &tmp, const std::string &path) {
 } // namespace
 
 void writeFileAtomic(const std::string &path, const std::string &bytes) {
-    writeFileAtomicWith(path, [&](const std::string &tmp) {
-        FILE *f = std::fopen(tmp.c_str(), "wb");
-        if (!f) throw Error("cannot write " + path + ": " + std::strerror(errno));
-        const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 &&
-                        ::fsync(::fileno(f)) == 0;
-        const int err = errno;
-        std::fclose(f);
-        if (!ok) throw Error("cannot write " + path + ": " + std::strerror(err));
-    });
+    std::string tmp;
+    const int fd = createTemporary(path, tmp);
+    size_t done = 0;
+    int err = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            err = n < 0 ? errno : ENOSPC;
+            break;
+        }
+        done += static_cast<size_t>(n);
+    }
+    if (err == 0 && ::fsync(fd) != 0) err = errno;
+    ::close(fd);
+    if (err != 0) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw Error("cannot write " + path + ": " + std::strerror(err));
+    }
+    commit(tmp, path);
 }
 
 void writeFileAtomicWith(const std::string &path, const std::function<void(const std::string &tmp)> &write) {
-    const std::string tmp = temporaryFor(path);
+    std::string tmp;
+    ::close(createTemporary(path, tmp)); // the name is ours; the writer opens it again
     try {
         write(tmp);
     } catch (...) {
@@ -73,7 +104,11 @@ void writeFileAtomicWith(const std::string &path, const std::function<void(const
         fs::remove(tmp, ec);
         throw;
     }
-    if (!fs::exists(tmp)) throw Error("cannot write " + path + ": the writer produced no file");
+    std::error_code ec;
+    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
+        fs::remove(tmp, ec);
+        throw Error("cannot write " + path + ": the writer produced no file");
+    }
     commit(tmp, path);
 }
 

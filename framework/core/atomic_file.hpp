@@ -12,8 +12,9 @@ namespace binocle {
 // holds more than maxBytes.
 std::string readTextFile(const std::string &path, uintmax_t maxBytes = uintmax_t{64} << 20);
 
-// Writes to "<path>.tmp-<pid>", flushes, then renames over path. On failure the old
-// file (if any) is untouched and the temporary is removed.
+// Writes to a new temporary beside path (".tmp-<pid>-<random>-<name>", created with
+// O_EXCL | O_NOFOLLOW: a planted symlink is never followed), fsyncs, then renames over
+// path. On failure the old file (if any) is untouched and the temporary is removed.
 void writeFileAtomic(const std::string &path, const std::string &bytes);
 
 // Same, for writers that need a file name (cv::imwrite): `write` receives the temporary

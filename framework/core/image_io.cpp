@@ -17,15 +17,21 @@
 namespace binocle {
 
 void writeImage(const std::string &path, const cv::Mat &image) {
-    writeFileAtomicWith(path, [&](const std::string &tmp) {
-        bool ok = false;
-        try {
-            ok = cv::imwrite(tmp, image);
-        } catch (const cv::Exception &e) {
-            throw Error("cannot write image " + path + ": " + e.err);
-        }
-        if (!ok) throw Error("cannot write image " + path);
-    });
+    // Encoded in memory, then written through writeFileAtomic's own descriptor: the file is
+    // never opened again by name (a symlink swapped in meanwhile is not followed).
+    const size_t dot = path.rfind('.');
+    const size_t slash = path.rfind('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+        throw Error("cannot write image " + path + ": no extension to choose the format by");
+    std::vector<uchar> bytes;
+    bool ok = false;
+    try {
+        ok = cv::imencode(path.substr(dot), image, bytes);
+    } catch (const cv::Exception &e) {
+        throw Error("cannot write image " + path + ": " + e.err);
+    }
+    if (!ok) throw Error("cannot write image " + path);
+    writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
 void writeDisparityPng16(const std::string &path, const cv::Mat &disparity) {

@@ -99,9 +99,18 @@ struct HostSink {
     std::function<void(const std::string &name, const std::string &text)> text;
 };
 
-// Common part of the instance wrappers.
-class PluginHelper;
+// How an instance runs: in this process, or behind a proxy that talks to its helper
+// process (host/isolation.hpp). Chosen once, when the instance is made; each kind's
+// wrapper holds one implementation of its kind's interface (kind_<name>.cpp).
+class InstanceImpl {
+public:
+    virtual ~InstanceImpl() = default;
+    virtual bool isolated() const { return false; }
+    virtual int32_t restarts() const { return 0; }
+    virtual int64_t lostCalls() const { return 0; }
+};
 
+// Common part of the instance wrappers.
 class PluginInstanceBase {
 public:
     // One wrapper per plugin instance: a copy would destroy the instance twice.
@@ -111,20 +120,28 @@ public:
     // Replaces where this instance's metrics and logs go (default: log to stderr).
     void setSink(HostSink sink);
     // True when the plugin runs in a helper process (`isolation: process`).
-    bool isolated() const { return helper_ != nullptr; }
+    bool isolated() const { return running_ && running_->isolated(); }
     // Restarts of its helper process, and calls whose result they lost (0 in process).
-    int32_t restarts() const;
-    int64_t lostCalls() const;
+    int32_t restarts() const { return running_ ? running_->restarts() : 0; }
+    int64_t lostCalls() const { return running_ ? running_->lostCalls() : 0; }
 
 protected:
     explicit PluginInstanceBase(const PluginRecord &record);
-    // Throws PluginError "<kind> plugin '<name>' (<path>): <what> failed (<code>): <message>".
-    [[noreturn]] void fail(const std::string &what, int32_t code, const char *message) const;
     // Instances of a described record run isolated whatever the rig says.
     static bool runsIsolated(const PluginRecord &record, const ParamValues &params);
+    // The implementation for this instance: InProcess(record, params, host) or, when it
+    // runs isolated, Proxy(record, params, host). The one place the choice is made.
+    template <class Impl, class InProcess, class Proxy>
+    std::unique_ptr<Impl> choose(const PluginRecord &record, const ParamValues &params) {
+        std::unique_ptr<Impl> impl;
+        if (runsIsolated(record, params)) impl = std::make_unique<Proxy>(record, params, host_);
+        else impl = std::make_unique<InProcess>(record, params, host_);
+        running_ = impl.get();
+        return impl;
+    }
     PluginRecord record_;
     std::shared_ptr<binocle_host> host_; // deleted with its sink context
-    PluginHelper *helper_ = nullptr;     // the derived class's helper, when isolated
+    const InstanceImpl *running_ = nullptr; // the derived wrapper's implementation
 };
 
 // A frame lent by a source; released when this object dies. Views are zero-copy.
@@ -152,11 +169,6 @@ private:
     binocle_stereo_frame frame_;
 };
 
-class SourceHelper;
-class MatcherHelper;
-class TransformHelper;
-class EvaluatorHelper;
-
 class Source : public PluginInstanceBase {
 public:
     Source(const PluginRecord &record, const ParamValues &params);
@@ -169,10 +181,10 @@ public:
     std::string statistics();
     static std::string enumerateDevices(const PluginRecord &record);
 
+    class Impl;
+
 private:
-    const binocle_source_api *api_;
-    std::shared_ptr<binocle_source> handle_;
-    std::unique_ptr<SourceHelper> isolated_;
+    std::unique_ptr<Impl> impl_;
 };
 
 class Matcher : public PluginInstanceBase {
@@ -192,10 +204,10 @@ public:
     // Disparities made invalid so far because they were not finite or absurd.
     uint64_t invalidatedDisparities() const { return invalidated_; }
 
+    class Impl;
+
 private:
-    const binocle_matcher_api *api_;
-    binocle_matcher *handle_ = nullptr;
-    std::unique_ptr<MatcherHelper> isolated_;
+    std::unique_ptr<Impl> impl_;
     uint64_t invalidated_ = 0;
     bool warnedInvalid_ = false;
 };
@@ -206,10 +218,10 @@ public:
     ~CloudTransform();
     void apply(binocle_cloud &cloud);
 
+    class Impl;
+
 private:
-    const binocle_cloud_transform_api *api_;
-    binocle_cloud_transform *handle_ = nullptr;
-    std::unique_ptr<TransformHelper> isolated_;
+    std::unique_ptr<Impl> impl_;
 };
 
 class Evaluator : public PluginInstanceBase {
@@ -219,10 +231,10 @@ public:
     void evaluate(const binocle_eval_input &input);
     void finish();
 
+    class Impl;
+
 private:
-    const binocle_evaluator_api *api_;
-    binocle_evaluator *handle_ = nullptr;
-    std::unique_ptr<EvaluatorHelper> isolated_;
+    std::unique_ptr<Impl> impl_;
 };
 
 enum class ScanMode {

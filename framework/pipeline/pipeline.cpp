@@ -11,7 +11,10 @@
 #include "core/image_io.hpp"
 #include "core/json.hpp"
 #include "core/progress.hpp"
+#include "pipeline/frame_writer.hpp"
+#include "pipeline/run_summary.hpp"
 #include "pipeline/stage_queue.hpp"
+#include "pipeline/stage_times.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -34,69 +37,6 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// Whether the source says its frames come on their own clock (cameras): the
-// `live: true` entry of its statistics (sdk/include/binocle/abi/source.h).
-bool sourceIsLive(const std::string &statistics) {
-    if (statistics.empty()) return false;
-    try {
-        const YAML::Node n = YAML::Load(statistics);
-        return n.IsMap() && n["live"] && n["live"].as<bool>(false);
-    } catch (const YAML::Exception &) {
-        return false;
-    }
-}
-
-// Frames a source lost before it could deliver them, from the counters of its
-// statistics that source.h names: `unpaired` at the top level (pairing), and
-// `failed_buffers`, `underrun_buffers`, `corrupt`, `dropped_by_driver` anywhere
-// (camera or transport), each named by where it sits ("cameras.left.failed_buffers").
-void sourceDrops(const YAML::Node &node, const std::string &path, Json &camera) {
-    static const char *kCameraKeys[] = {"failed_buffers", "underrun_buffers", "corrupt", "dropped_by_driver"};
-    if (node.IsMap()) {
-        for (const auto &kv : node) {
-            const std::string key = kv.first.as<std::string>("");
-            const std::string where = path.empty() ? key : path + "." + key;
-            bool counted = false;
-            for (const char *k : kCameraKeys)
-                if (key == k && kv.second.IsScalar()) {
-                    camera[where] = kv.second.as<int64_t>(0);
-                    counted = true;
-                }
-            if (!counted) sourceDrops(kv.second, where, camera);
-        }
-    } else if (node.IsSequence()) {
-        for (size_t i = 0; i < node.size(); ++i) {
-            std::string name = std::to_string(i);
-            if (node[i].IsMap() && node[i]["role"] && node[i]["role"].IsScalar()) name = node[i]["role"].Scalar();
-            sourceDrops(node[i], path + "." + name, camera);
-        }
-    }
-}
-
-// One line per frame, flushed as it is written: a killed run keeps every finished frame.
-class FramesFile {
-public:
-    explicit FramesFile(const std::string &path) {
-        if (path.empty()) return;
-        file_ = std::fopen(path.c_str(), "w");
-        if (!file_) throw Error(path + ": cannot write: " + std::strerror(errno));
-        path_ = path;
-    }
-    ~FramesFile() {
-        if (file_) std::fclose(file_);
-    }
-    void write(const Json &line) {
-        if (!file_) return;
-        const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-        if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0)
-            throw Error(path_ + ": cannot write: " + std::strerror(errno));
-    }
-
-private:
-    std::FILE *file_ = nullptr;
-    std::string path_;
-};
 
 } // namespace
 
@@ -139,6 +79,7 @@ struct Pipeline::RunState {
     struct Grabbed {
         std::unique_ptr<LentFrame> frame;
         Clock::time_point at;
+        double seconds = 0; // in the source's grab
     };
     RunState(const RunOptions &o, size_t sourceDepth, size_t stageDepth)
         : options(o), sourceQueue(sourceDepth), matched(stageDepth), clouded(stageDepth), evaluated(stageDepth) {}
@@ -160,6 +101,12 @@ struct Pipeline::RunState {
     std::atomic<bool> aborted{false};
     std::mutex failMutex;
     std::string failure;
+
+    // The writer stage's, read after it ends.
+    std::unique_ptr<FrameWriter> folder; // out_dir's
+    std::vector<FrameWriter *> writers;  // the folder's, then the caller's
+    RunTimes times;
+    int64_t written = 0; // frames through every stage
 
     // Written by the acquire stage, read after it is joined.
     int64_t grabbed = 0, droppedByPolicy = 0, sourceErrors = 0, recoveries = 0;
@@ -198,6 +145,22 @@ std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
     } catch (const std::exception &e) {
         spdlog::debug("matcher disparity range: {}", e.what());
         return {0, 0};
+    }
+}
+
+// The pose of Eq. 1 for the evaluators: the settings camera_height_mm and
+// inclination_deg of the first transform that declares both (cloud_transform.h).
+void putGroundPose(binocle_eval_input &in, const RigConfig &rig) {
+    auto number = [](const binocle_param *p) {
+        return p->type == BINOCLE_PARAM_INT ? static_cast<double>(p->i) : p->d;
+    };
+    for (const auto &t : rig.transforms) {
+        const binocle_param *h = t.params.find("camera_height_mm"), *i = t.params.find("inclination_deg");
+        if (!h || !i) continue;
+        in.ground_pose_known = 1;
+        in.camera_height_mm = number(h);
+        in.inclination_deg = number(i);
+        return;
     }
 }
 
@@ -335,7 +298,21 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
                                     map2x_, map2y_);
     }
     projector_ = CloudProjector(calibration_, rig_.outputs.max_range_mm);
+    imageSize_ = imageSize;
     calibrationReady_ = true;
+}
+
+// The maps, the projector and the geometry check were made for the first frame's size:
+// a frame of another size would be rectified and triangulated with the wrong geometry.
+void Pipeline::checkFrameSize(const LentFrame &frame, int64_t ordinal) const {
+    const cv::Size left = frame.left().size(), right = frame.right().size();
+    if (left == imageSize_ && right == imageSize_) return;
+    auto text = [](const cv::Size &z) { return std::to_string(z.width) + "x" + std::to_string(z.height); };
+    throw Error("frame " + std::to_string(ordinal) + " (sequence " + std::to_string(frame.raw().sequence) + ") of source '" +
+                rig_.source.plugin + "': left image " + text(left) + ", right image " + text(right) + "; expected " +
+                text(imageSize_) + " as the frames before it and the calibration (" +
+                (rig_.calibration_file ? *rig_.calibration_file : "published by the source") +
+                "): refusing to process it with the wrong geometry (did the source change its image size mid-run?)");
 }
 
 // Stage 1: grabs pairs and queues them by the policy. A grab waits in short slices so
@@ -366,8 +343,9 @@ void Pipeline::acquire(RunState &s) {
                 if (s.aborted || s.stopRequested() || !s.options.between_frames()) break;
             }
             std::unique_ptr<LentFrame> frame;
+            const auto grabStart = Clock::now();
             try {
-                const auto t0 = Clock::now();
+                const auto t0 = grabStart;
                 const int32_t total = s.options.grab_timeout_ms;
                 for (;;) {
                     const int32_t left = total < 0 ? 250 : std::max<int32_t>(1, total - static_cast<int32_t>(secondsSince(t0) * 1000));
@@ -402,13 +380,15 @@ void Pipeline::acquire(RunState &s) {
                 s.endOfStream = true;
                 break;
             }
+            const double grabSeconds = secondsSince(grabStart);
             if (!calibrationReady_) prepareCalibration(frame->left().size());
+            checkFrameSize(*frame, s.grabbed);
             if (Clock::now() - lastStatistics > std::chrono::milliseconds(500)) {
                 refreshSourceStatistics();
                 lastStatistics = Clock::now();
             }
             ++s.grabbed;
-            RunState::Grabbed g{std::move(frame), Clock::now()};
+            RunState::Grabbed g{std::move(frame), Clock::now(), grabSeconds};
             if (s.policy == RuntimeOptions::Policy::Latest) {
                 if (s.sourceQueue.pushDropOldest(std::move(g))) ++s.droppedByPolicy; // released here
             } else if (!s.sourceQueue.pushWait(g)) {
@@ -439,6 +419,7 @@ void Pipeline::rectifyAndMatch(RunState &s, size_t instance) {
         r.sequence = job->frame->raw().sequence;
         r.frame = job->frame.get();
         r.seconds = 0;
+        r.acquire_seconds = g->seconds;
         r.stage_seconds.clear();
         if (!job->failed) {
             try {
@@ -531,6 +512,9 @@ void Pipeline::evaluate(RunState &s) {
                 in.calibration_yaml = calibrationYaml_.c_str();
                 in.rig_yaml = rig_.resolved_yaml.c_str();
                 in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
+                in.min_disparity = disparityRange_.first;
+                in.num_disparities = disparityRange_.second;
+                putGroundPose(in, rig_);
                 for (auto &slot : evaluators_) {
                     Json figures = Json::object();
                     slot->target = &figures;
@@ -559,18 +543,44 @@ void Pipeline::evaluate(RunState &s) {
     s.evaluated.producerDone();
 }
 
-void writeFrameOutputs(const FrameResult &r, const OutputOptions &o, const std::string &dir) {
-    char stem[32];
-    std::snprintf(stem, sizeof stem, "%06llu", static_cast<unsigned long long>(r.sequence));
-    const fs::path d(dir);
-    if (o.disparity_png) writeDisparityPng16((d / ("disparity_" + std::string(stem) + ".png")).string(), r.disparity);
-    if (o.disparity_color) writeImage((d / ("disparity_color_" + std::string(stem) + ".png")).string(), colorizeDisparity(r.disparity));
-    if (o.disparity_pfm) writePfm((d / ("disparity_" + std::string(stem) + ".pfm")).string(), r.disparity);
-    if (o.rectified_png) {
-        writeImage((d / ("rectified_left_" + std::string(stem) + ".png")).string(), r.rectified_left);
-        writeImage((d / ("rectified_right_" + std::string(stem) + ".png")).string(), r.rectified_right);
+// Stage 5, on the calling thread: the writers, the caller's onFrame, the observers; then
+// the job goes back to the pool and the drain of between_frames learns of it.
+void Pipeline::write(RunState &s, const std::function<void(const FrameResult &)> &onFrame) {
+    Progress progress(s.options.progress, "frame", s.options.max_frames);
+    while (std::optional<std::unique_ptr<Job>> job = s.evaluated.pop()) {
+        FrameResult &r = (*job)->r;
+        if (!(*job)->failed && !s.aborted) {
+            try {
+                const auto t0 = Clock::now();
+                r.latency_s = secondsSince((*job)->grabbed);
+                for (FrameWriter *w : s.writers) w->write(r);
+                const double written = secondsSince(t0);
+                r.seconds += written;
+                if (onFrame) onFrame(r);
+                for (FrameObserver *o : observers_) o->onFrame(r);
+                s.times.add("acquire", r.acquire_seconds);
+                for (const auto &[stage, seconds] : r.stage_seconds) s.times.add(stage, seconds);
+                s.times.add("write", written);
+                ++s.written;
+                progress.update(s.written);
+            } catch (const std::exception &e) {
+                s.fail(e.what());
+            }
+        }
+        // Views into the lent frame must not outlive it; owned buffers stay for reuse.
+        if (calibration_.rectified) {
+            r.rectified_left.release();
+            r.rectified_right.release();
+        }
+        r.frame = nullptr;
+        (*job)->frame.reset();
+        s.giveJob(std::move(*job));
+        {
+            std::lock_guard<std::mutex> lock(s.doneMutex);
+            ++s.finished;
+        }
+        s.doneCv.notify_all();
     }
-    if (o.cloud_ply) writePly((d / ("cloud_" + std::string(stem) + ".ply")).string(), r.cloud);
 }
 
 Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {
@@ -581,13 +591,6 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
         if (ec) throw Error("--out " + outDir_ + ": cannot create the folder: " + ec.message());
     }
     const RuntimeOptions &rt = rig_.runtime;
-    Json summary = Json::object();
-    summary["rig"] = rig_.file;
-    summary["name"] = rig_.name;
-    summary["source"] = rig_.source.plugin;
-    summary["matcher"] = rig_.matcher.plugin;
-    summary["units"] = {{"length", "mm"}, {"disparity", "px"}, {"disparity_png_scale", 256}};
-
     // Between processing stages a few frames are enough to absorb jitter; the policy
     // acts on the queue at the source, which is the rig's queue_depth.
     const size_t stageDepth = static_cast<size_t>(std::max(2, rt.matcher_instances));
@@ -601,74 +604,33 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     const size_t jobs = matchers_.size() + 3 * stageDepth + 3;
     for (size_t i = 0; i < jobs; ++i) s.pool.push_back(std::make_unique<Job>());
     s.matched.setProducers(static_cast<int>(matchers_.size()));
-
-    summary["runtime"] = {{"policy", s.policy == RuntimeOptions::Policy::Latest ? "latest" : "lossless"},
-                          {"policy_from", rt.policy ? "rig" : live ? "source (live)" : "source (not live)"},
-                          {"queue_depth", rt.queue_depth},
-                          {"matcher_instances", rt.matcher_instances},
-                          {"on_source_error", rt.on_source_error == RuntimeOptions::OnSourceError::Retry ? "retry" : "stop"}};
-    if (rt.on_source_error == RuntimeOptions::OnSourceError::Retry) summary["runtime"]["retry_for_s"] = rt.retry_for_s;
+    Json summary = runHeader(rig_, s.policy, live);
 
     const auto start = Clock::now();
-    int64_t count = 0;
-    std::optional<FramesFile> frames;
     try {
-        frames.emplace(outDir_.empty() ? "" : (fs::path(outDir_) / "frames.jsonl").string());
+        if (!outDir_.empty()) s.writers.push_back((s.folder = makeFolderWriter(outDir_, rig_.outputs)).get());
+        for (FrameWriter *w : options.writers) s.writers.push_back(w);
     } catch (const std::exception &e) {
         s.fail(e.what());
     }
-
     if (!s.aborted) {
         std::vector<std::thread> threads;
         threads.emplace_back([&] { acquire(s); });
         for (size_t i = 0; i < matchers_.size(); ++i) threads.emplace_back([&, i] { rectifyAndMatch(s, i); });
         threads.emplace_back([&] { cloudAndTransforms(s); });
         threads.emplace_back([&] { evaluate(s); });
-
-        // Stage 5, here: outputs, the frame's line, observers; then the job goes back.
-        Progress progress(options.progress, "frame", options.max_frames);
-        while (std::optional<std::unique_ptr<Job>> job = s.evaluated.pop()) {
-            FrameResult &r = (*job)->r;
-            if (!(*job)->failed && !s.aborted) {
-                try {
-                    const auto t0 = Clock::now();
-                    if (!outDir_.empty()) writeFrameOutputs(r, rig_.outputs, outDir_);
-                    r.seconds += secondsSince(t0);
-                    r.latency_s = secondsSince((*job)->grabbed);
-                    Json line = Json::object();
-                    line["index"] = r.index;
-                    line["sequence"] = r.sequence;
-                    line["valid_pixel_ratio"] = r.valid_pixel_ratio;
-                    line["points"] = r.cloud.size();
-                    line["seconds"] = r.seconds;
-                    line["latency_s"] = r.latency_s;
-                    line["metrics"] = r.metrics;
-                    frames->write(line);
-                    if (onFrame) onFrame(r);
-                    for (FrameObserver *o : observers_) o->onFrame(r);
-                    ++count;
-                    progress.update(count);
-                } catch (const std::exception &e) {
-                    s.fail(e.what());
-                }
-            }
-            // Views into the lent frame must not outlive it; owned buffers stay for reuse.
-            if (calibration_.rectified) {
-                r.rectified_left.release();
-                r.rectified_right.release();
-            }
-            r.frame = nullptr;
-            (*job)->frame.reset();
-            s.giveJob(std::move(*job));
-            {
-                std::lock_guard<std::mutex> lock(s.doneMutex);
-                ++s.finished;
-            }
-            s.doneCv.notify_all();
-        }
+        write(s, onFrame);
         for (auto &t : threads) t.join();
     }
+    const std::string failure = finishSummary(s, summary, secondsSince(start));
+    if (!outDir_.empty()) writeFileAtomic((fs::path(outDir_) / "summary.json").string(), dumpJson(summary));
+    if (!failure.empty()) throw Error(failure);
+    return summary;
+}
 
+// The figures of a finished run: the evaluators' totals, counts, status, drops, stage
+// times, isolation and calibration. Returns the run's failure ("" when none).
+std::string Pipeline::finishSummary(RunState &s, Json &summary, double elapsed) {
     const bool interrupted = s.stopRequested() && !s.endOfStream;
     std::string failure = s.failure;
     if (failure.empty()) {
@@ -692,35 +654,25 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     } catch (const std::exception &e) {
         spdlog::warn("source statistics: {}", e.what());
     }
-    const double elapsed = secondsSince(start);
-    summary["frame_count"] = count;
+    summary["frame_count"] = s.written;
     summary["frames_grabbed"] = s.grabbed;
     summary["seconds"] = elapsed;
-    summary["frames_per_second"] = elapsed > 0 ? count / elapsed : 0.0;
+    summary["frames_per_second"] = elapsed > 0 ? s.written / elapsed : 0.0;
     summary["status"] = !failure.empty() ? "failed" : interrupted ? "interrupted" : "ok";
     if (!failure.empty()) summary["error"] = failure;
-    if (!outDir_.empty()) summary["frames_file"] = "frames.jsonl";
-
-    Json dropped = Json::object();
-    dropped["by_policy"] = s.droppedByPolicy;
-    Json camera = Json::object();
-    int64_t unpaired = 0;
-    if (!stats.empty()) {
-        summary["source_statistics"] = stats;
+    for (FrameWriter *w : s.writers) {
         try {
-            const YAML::Node n = YAML::Load(stats);
-            if (n.IsMap() && n["unpaired"] && n["unpaired"].IsScalar()) unpaired = n["unpaired"].as<int64_t>(0);
-            sourceDrops(n, "", camera);
-        } catch (const YAML::Exception &) {
+            w->finish(summary);
+        } catch (const std::exception &e) {
+            if (failure.empty()) summary["error"] = failure = e.what();
+            summary["status"] = "failed";
         }
     }
-    dropped["by_pairing"] = unpaired;
-    int64_t cameraTotal = 0;
-    for (const auto &[k, v] : camera.items()) cameraTotal += v.get<int64_t>();
-    dropped["by_camera_or_transport"] = cameraTotal;
-    dropped["camera_or_transport"] = camera;
-    dropped["total"] = s.droppedByPolicy + unpaired + cameraTotal;
-    summary["dropped"] = dropped;
+    // Where the time of a frame goes (only frames that went all the way through).
+    summary["stage_seconds_per_frame"] = s.times.summary();
+    if (!stats.empty()) summary["source_statistics"] = stats;
+    summary["dropped"] = droppedSummary(s.droppedByPolicy, stats);
+    const RuntimeOptions &rt = rig_.runtime;
     if (s.sourceErrors > 0 || rt.on_source_error == RuntimeOptions::OnSourceError::Retry)
         summary["source_errors"] = {{"outages", s.sourceErrors}, {"recovered", s.recoveries}, {"last", s.lastSourceError}};
     // Plugins in helper processes (`isolation: process`): restarts, and the calls whose
@@ -745,9 +697,7 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
                                   {"image_width", calibration_.image_size.width},
                                   {"image_height", calibration_.image_size.height}};
     }
-    if (!outDir_.empty()) writeFileAtomic((fs::path(outDir_) / "summary.json").string(), dumpJson(summary));
-    if (!failure.empty()) throw Error(failure);
-    return summary;
+    return failure;
 }
 
 } // namespace binocle

@@ -8,6 +8,7 @@
 #include "core/calibration.hpp"
 #include "core/cloud.hpp"
 #include "host/plugin_host.hpp"
+#include "pipeline/frame_writer.hpp"
 
 #include <atomic>
 #include <functional>
@@ -37,6 +38,9 @@ struct RunOptions {
     // frame in flight). Set: only while it is true (a change or a pause is pending), so
     // the stages run in parallel the rest of the time and drain only when needed.
     const std::atomic<bool> *between_frames_wanted = nullptr;
+    // More outputs (a bag), called after the folder's on the writer stage; they must
+    // outlive the run (pipeline/frame_writer.hpp).
+    std::vector<FrameWriter *> writers;
 };
 
 // What one frame produced, for callers that want more than files (experiments, tests,
@@ -54,6 +58,7 @@ struct FrameResult {
     std::vector<std::pair<std::string, double>> figures; // the same, flat: "evaluator.metric"
     double seconds = 0;   // processing time of the frame, all stages added
     double latency_s = 0; // from the grab to the writer stage
+    double acquire_seconds = 0; // in the source's grab (a camera's wait for its next image included)
     // Time of each step, in order: rectify, match, cloud, transforms, evaluators.
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
@@ -91,9 +96,6 @@ private:
     std::atomic<uint64_t> skipped_{0};
 };
 
-// Writes what `outputs` asks for of one frame into `dir` (disparity PNG/PFM, colourised
-// disparity, rectified images, cloud PLY), each file atomically; names carry the sequence.
-void writeFrameOutputs(const FrameResult &r, const OutputOptions &outputs, const std::string &dir);
 
 class Pipeline {
 public:
@@ -135,6 +137,9 @@ private:
     void rectifyAndMatch(RunState &s, size_t instance);
     void cloudAndTransforms(RunState &s);
     void evaluate(RunState &s);
+    void write(RunState &s, const std::function<void(const FrameResult &)> &onFrame);
+    std::string finishSummary(RunState &s, nlohmann::ordered_json &summary, double elapsed);
+    void checkFrameSize(const LentFrame &frame, int64_t ordinal) const;
     void refreshSourceStatistics();
     std::unique_ptr<EvaluatorSlot> makeEvaluator(const PluginBlock &block);
 
@@ -157,6 +162,7 @@ private:
     StereoCalibration calibration_;
     std::string calibrationYaml_;
     bool calibrationReady_ = false;
+    cv::Size imageSize_; // of the frames the maps were made for
     cv::Mat map1x_, map1y_, map2x_, map2y_;
     CloudProjector projector_;
     std::string outDir_;

@@ -5,7 +5,9 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/output_folder.hpp"
 #include "core/progress.hpp"
+#include "rosbag/rosbag_recording.hpp"
 
 #include <binocle/recording.hpp>
 
@@ -18,6 +20,9 @@
 #include <deque>
 #include <fcntl.h>
 #include <filesystem>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -33,14 +38,48 @@ namespace binocle {
 
 namespace {
 
-std::string listed(const fs::path &dir) {
+// What a folder holds, but the lock of the process that owns it (core/output_folder.hpp).
+std::vector<std::string> entriesOf(const fs::path &dir) {
     std::vector<std::string> names;
-    for (const auto &e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir))
+        if (e.path().filename() != OutputFolder::kLockFile) names.push_back(e.path().filename().string());
+    return names;
+}
+
+std::string listed(const fs::path &dir) {
+    std::vector<std::string> names = entriesOf(dir);
     std::sort(names.begin(), names.end());
     std::string out;
     for (size_t i = 0; i < names.size() && i < 4; ++i) out += (i ? ", " : "") + names[i];
     if (names.size() > 4) out += ", ... (" + std::to_string(names.size()) + " entries)";
     return out;
+}
+
+// Where a write failed, for the message: the filesystem holding `dir`, where it is
+// mounted and how much room it has left. A full disk is the usual cause and the user
+// must see which one.
+std::string diskOf(const std::string &dir) {
+    std::error_code ec;
+    fs::path at = fs::absolute(dir, ec).lexically_normal();
+    struct stat st {};
+    if (::stat(at.c_str(), &st) != 0) return "";
+    const dev_t device = st.st_dev;
+    while (at.has_parent_path() && at.parent_path() != at) {
+        struct stat up {};
+        if (::stat(at.parent_path().c_str(), &up) != 0 || up.st_dev != device) break;
+        at = at.parent_path();
+    }
+    struct statvfs vfs {};
+    if (::statvfs(dir.c_str(), &vfs) != 0) return "";
+    auto kib = [](unsigned long long bytes) { return std::to_string(bytes / 1024) + " KiB"; };
+    std::string note = "the disk holding " + dir + " (the filesystem mounted at " + at.string() + ") has " +
+                       kib(static_cast<unsigned long long>(vfs.f_bavail) * vfs.f_frsize) + " free of " +
+                       kib(static_cast<unsigned long long>(vfs.f_blocks) * vfs.f_frsize);
+    struct rlimit limit {};
+    if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+        note += "; this process may write files of at most " + kib(static_cast<unsigned long long>(limit.rlim_cur)) +
+                " (ulimit -f)";
+    return note;
 }
 
 // A lent image as a cv::Mat view; RGB8 is flagged so that PNG gets the right colours.
@@ -101,10 +140,11 @@ struct RecordingWriter::Pool {
             if (todo.empty()) return;
             std::shared_ptr<Job> job = todo.front();
             todo.pop_front();
+            const bool skip = !error.empty(); // nothing after a failure is listed: not written either
             lock.unlock();
             double encodeMs = 0, writeMs = 0;
             try {
-                writeImages(*job, encodeMs, writeMs);
+                if (!skip) writeImages(*job, encodeMs, writeMs);
             } catch (const std::exception &e) {
                 job->error = e.what();
             }
@@ -115,8 +155,14 @@ struct RecordingWriter::Pool {
             --inMemory;
             stats.encode_ms += encodeMs;
             stats.write_ms += writeMs;
+            const bool orphan = !error.empty(); // the committer has given up on it
             roomAvailable.notify_all();
             jobDone.notify_all();
+            if (orphan && !skip) {
+                lock.unlock();
+                removeImages({job});
+                lock.lock();
+            }
         }
     }
 
@@ -135,7 +181,11 @@ struct RecordingWriter::Pool {
             }
             const auto t1 = std::chrono::steady_clock::now();
             // Temporary file, fsync, rename: the image is complete on disk before its row.
-            writeFileAtomic(file, std::string(png.begin(), png.end()));
+            try {
+                writeFileAtomic(file, std::string(png.begin(), png.end()));
+            } catch (const std::exception &e) {
+                throw Error(std::string("record: ") + e.what() + onDisk());
+            }
             encodeMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
             writeMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
         }
@@ -178,21 +228,55 @@ struct RecordingWriter::Pool {
                 if (failure.empty()) {
                     rows += static_cast<int64_t>(batch.size());
                     ++stats.syncs;
-                } else if (error.empty()) {
-                    error = failure;
+                } else {
+                    if (error.empty()) error = failure;
+                    // Their rows never made it: their images are orphans too.
+                    inOrder.insert(inOrder.begin(), batch.begin(), batch.end());
                 }
             }
-            if (!error.empty()) inOrder.clear(); // nothing after a failure is listed
+            if (!error.empty()) {
+                // Nothing after a failure is listed. The images written for frames that
+                // will never have a row go (on a full disk they hold the room the summary
+                // needs); frames still being written are removed by their worker.
+                std::vector<std::shared_ptr<Job>> orphans;
+                for (const auto &job : inOrder)
+                    if (job->done) orphans.push_back(job);
+                inOrder.clear();
+                committed.notify_all();
+                roomAvailable.notify_all();
+                lock.unlock();
+                removeImages(orphans);
+                return; // the workers finish (or skip) their queue on their own
+            }
             if (rows == submitted) flushRequested = false;
             committed.notify_all();
-            if (committerStopping && (inOrder.empty() || !error.empty())) return;
+            if (committerStopping && inOrder.empty()) return;
         }
+    }
+
+    void removeImages(const std::vector<std::shared_ptr<Job>> &jobs) const {
+        std::error_code ec;
+        for (const auto &job : jobs)
+            for (int i = 0; i < 2; ++i) fs::remove(fs::path(dir) / recording::imagePath(i, job->sequence), ec);
     }
 
     void writeRows(const std::vector<std::shared_ptr<Job>> &batch) {
         std::vector<recording::Row> rows;
         for (const auto &job : batch) rows.push_back(recording::rowFor(job->sequence, job->tl, job->tr));
-        recording::appendRowsDurably(csvFd, dirFds, rows, dir);
+        const off_t before = ::lseek(csvFd, 0, SEEK_END);
+        try {
+            recording::appendRowsDurably(csvFd, dirFds, rows, dir);
+        } catch (const std::exception &e) {
+            // A row cut short by a full disk would be a corrupt last line: the index goes
+            // back to its last complete row.
+            if (before >= 0 && ::ftruncate(csvFd, before) == 0) ::fsync(csvFd);
+            throw Error(std::string("record: ") + e.what() + onDisk());
+        }
+    }
+
+    std::string onDisk() const {
+        const std::string disk = diskOf(dir);
+        return disk.empty() ? "" : "; " + disk;
     }
 
     void rethrow() const {
@@ -221,7 +305,7 @@ RecordingWriter::RecordingWriter(const std::string &dir, const std::string &cali
     std::error_code ec;
     if (fs::exists(dir_, ec)) {
         if (!fs::is_directory(dir_, ec)) throw Error("record: " + dir_ + " exists and is not a folder");
-        if (!fs::is_empty(dir_, ec))
+        if (!entriesOf(dir_).empty())
             throw Error("record: " + dir_ + " is not empty (it holds " + listed(dir_) +
                         "): refusing to record over it; choose a new folder");
     }
@@ -427,14 +511,12 @@ nlohmann::ordered_json recordingSummary(const RecordResult &r) {
     return j;
 }
 
-RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
-                       const std::function<void(int64_t frames)> &onFrame) {
-    Source source(*rig.source.record, rig.source.params);
-    std::string calibration;
-    if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
-    else calibration = source.calibration();
-    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
+namespace {
 
+// The recording loop, the same for each format's writer (RecordingWriter, RosbagRecordingWriter).
+template <typename Writer>
+RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, const RecordOptions &options,
+                        const std::function<void(int64_t frames)> &onFrame) {
     RecordResult result;
     bool live = false;
     try {
@@ -466,6 +548,10 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
     } catch (const std::exception &e) {
         result.error = e.what();
         result.status = "error";
+        try {
+            source.stop(); // a camera is let go at once, not when the summary is written
+        } catch (const std::exception &) {
+        }
     }
     try {
         writer.finish();
@@ -487,6 +573,24 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
         spdlog::warn("record: {}", e.what());
     }
     return result;
+}
+
+} // namespace
+
+RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
+                       const std::function<void(int64_t frames)> &onFrame) {
+    Source source(*rig.source.record, rig.source.params);
+    std::string calibration;
+    if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
+    else calibration = source.calibration();
+    if (options.format == "mcap") {
+        RosbagRecordingWriter writer(dir, calibration, rig.resolved_yaml, options.rosbag, options.writer);
+        return recordWith(writer, source, dir, options, onFrame);
+    }
+    if (options.format != "folder")
+        throw Error("record: format '" + options.format + "': expected folder or mcap");
+    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
+    return recordWith(writer, source, dir, options, onFrame);
 }
 
 } // namespace binocle

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// SIGINT / SIGTERM: a first signal asks for a clean stop, a second ends at once.
+// SIGINT / SIGTERM / SIGHUP: a first signal asks for a clean stop, a second ends at once.
 #include "pipeline/stop_signal.hpp"
 
 #include "core/error.hpp"
@@ -13,7 +13,7 @@ namespace {
 std::atomic<bool> g_requested{false};
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_installed{false};
-struct sigaction g_oldInt, g_oldTerm;
+struct sigaction g_oldInt, g_oldTerm, g_oldHup;
 
 void onStopSignal(int sig) {
     // Only async-signal-safe calls here: atomics and _exit.
@@ -34,11 +34,17 @@ StopSignalGuard::StopSignalGuard() {
     sa.sa_flags = SA_RESTART;
     sigaction(SIGINT, &sa, &g_oldInt);
     sigaction(SIGTERM, &sa, &g_oldTerm);
+    // A closed terminal (SSH dropped, tmux pane killed) is a request to stop like any
+    // other: the frames in flight are finished and the summary written. Under nohup
+    // (SIGHUP ignored) it stays ignored.
+    sigaction(SIGHUP, nullptr, &g_oldHup);
+    if (g_oldHup.sa_handler != SIG_IGN) sigaction(SIGHUP, &sa, nullptr);
 }
 
 StopSignalGuard::~StopSignalGuard() {
     sigaction(SIGINT, &g_oldInt, nullptr);
     sigaction(SIGTERM, &g_oldTerm, nullptr);
+    sigaction(SIGHUP, &g_oldHup, nullptr);
     g_installed = false;
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// SIGINT / SIGTERM for long runs: the first asks the run to stop cleanly (finish the
+// SIGINT / SIGTERM / SIGHUP for long runs: the first asks the run to stop cleanly (finish the
 // frames in flight, write the summary), the second ends the process at once.
 #pragma once
 
@@ -7,7 +7,7 @@
 
 namespace binocle {
 
-// While alive, SIGINT and SIGTERM set `requested()` instead of killing the process; a
+// While alive, SIGINT, SIGTERM and SIGHUP set `requested()` instead of killing the process; a
 // second signal exits at once with 128 + signal. The previous handlers come back on
 // destruction. One guard at a time per process.
 class StopSignalGuard {

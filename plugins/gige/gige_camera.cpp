@@ -48,6 +48,13 @@ std::string joinStrings(const char **items, guint n) {
 
 } // namespace
 
+std::optional<Trigger> triggerNamed(const std::string &name) {
+    if (name == "free_run") return Trigger::FreeRun;
+    if (name == "software") return Trigger::Software;
+    if (name == "hardware") return Trigger::Hardware;
+    return std::nullopt;
+}
+
 // ---- Notifier -------------------------------------------------------------------------
 
 void Notifier::notify() {
@@ -156,7 +163,21 @@ void Camera::fail(int32_t code, const std::string &what) const {
 }
 
 void Camera::configure() {
+    identify();
     GErrorSlot error;
+    // A camera left acquiring by an earlier session refuses some settings.
+    arv_camera_stop_acquisition(camera_, error.out());
+    arv_camera_set_acquisition_mode(camera_, ARV_ACQUISITION_MODE_CONTINUOUS, error.out());
+    configurePixelFormat();
+    configureImageSize();
+    configureExposureGainRate();
+    configureTrigger();
+    if (arv_camera_is_gv_device(camera_)) configureTransport();
+    openStream();
+}
+
+// Its address and label; refuses a camera another controller holds.
+void Camera::identify() {
     ArvDevice *device = arv_camera_get_device(camera_);
     address_ = settings_.id;
     if (arv_camera_is_gv_device(camera_)) {
@@ -172,12 +193,11 @@ void Camera::configure() {
     // time out, one after the other.
     if (ARV_IS_GV_DEVICE(device) && !arv_gv_device_is_controller(ARV_GV_DEVICE(device)))
         fail(BINOCLE_ERR_BUSY, "another application (or another source) controls it; close that first");
+}
 
-    // A camera left acquiring by an earlier session refuses some settings.
-    arv_camera_stop_acquisition(camera_, error.out());
-    arv_camera_set_acquisition_mode(camera_, ARV_ACQUISITION_MODE_CONTINUOUS, error.out());
-
-    // Pixel format: compared by PFNC value, so "RGB8" and "RGB8Packed" name the same.
+// Pixel format: compared by PFNC value, so "RGB8" and "RGB8Packed" name the same.
+void Camera::configurePixelFormat() {
+    GErrorSlot error;
     const PixelFormat &format = *settings_.format;
     {
         guint n = 0, nNames = 0;
@@ -193,9 +213,12 @@ void Camera::configure() {
         arv_camera_set_pixel_format(camera_, format.arv, error.out());
         if (error) fail(BINOCLE_ERR_DEVICE, "pixel_format = " + std::string(format.name) + " refused: " + error.message());
     }
+}
 
-    // Width and Height: Aravis's bounds know the sensor size (the features' own maximum
-    // may be unbounded).
+// Width and Height: Aravis's bounds know the sensor size (the features' own maximum
+// may be unbounded).
+void Camera::configureImageSize() {
+    GErrorSlot error;
     using Bounds = void (*)(ArvCamera *, gint *, gint *, GError **);
     using Increment = gint (*)(ArvCamera *, GError **);
     auto setDimension = [&](const char *feature, const char *key, const char *offset, int64_t value, Bounds bounds,
@@ -219,8 +242,11 @@ void Camera::configure() {
         setDimension("Width", "width", "OffsetX", *settings_.width, arv_camera_get_width_bounds, arv_camera_get_width_increment);
     if (settings_.height)
         setDimension("Height", "height", "OffsetY", *settings_.height, arv_camera_get_height_bounds, arv_camera_get_height_increment);
+}
 
-    // Float features: switch the automatic off, check the camera's range, set.
+// Float features: switch the automatic off, check the camera's range, set.
+void Camera::configureExposureGainRate() {
+    GErrorSlot error;
     struct FloatFeature {
         const char *key, *unit, *what;
         const std::optional<double> &value;
@@ -251,15 +277,19 @@ void Camera::configure() {
         f.set(camera_, *f.value, error.out());
         if (error) fail(BINOCLE_ERR_INVALID_ARGUMENT, given + " refused: " + error.message());
     }
+}
 
-    if (settings_.trigger == "free_run") {
-        arv_camera_clear_triggers(camera_, error.out());
-    } else if (settings_.trigger == "software") {
+void Camera::configureTrigger() {
+    GErrorSlot error;
+    switch (settings_.trigger) {
+    case Trigger::FreeRun: arv_camera_clear_triggers(camera_, error.out()); break;
+    case Trigger::Software:
         if (!arv_camera_is_software_trigger_supported(camera_, nullptr))
             fail(BINOCLE_ERR_UNSUPPORTED, "trigger = software: the camera has no software trigger");
         arv_camera_set_trigger(camera_, "Software", error.out());
         if (error) fail(BINOCLE_ERR_DEVICE, "trigger = software refused: " + error.message());
-    } else {
+        break;
+    case Trigger::Hardware: {
         guint n = 0;
         const char **sources = arv_camera_dup_available_trigger_sources(camera_, &n, error.out());
         bool found = false;
@@ -270,11 +300,16 @@ void Camera::configure() {
             fail(BINOCLE_ERR_INVALID_ARGUMENT, "trigger_line = " + settings_.trigger_line + " not offered (the camera offers: " + all + ")");
         arv_camera_set_trigger(camera_, settings_.trigger_line.c_str(), error.out());
         if (error) fail(BINOCLE_ERR_DEVICE, "trigger_line = " + settings_.trigger_line + " refused: " + error.message());
+        break;
     }
+    }
+}
 
-    if (arv_camera_is_gv_device(camera_)) configureTransport();
-
-    // What the camera will really send.
+// What the camera will really send, then its stream and the control-lost watch.
+void Camera::openStream() {
+    GErrorSlot error;
+    ArvDevice *device = arv_camera_get_device(camera_);
+    const PixelFormat &format = *settings_.format;
     width_ = static_cast<int>(arv_camera_get_integer(camera_, "Width", error.out()));
     height_ = static_cast<int>(arv_camera_get_integer(camera_, "Height", error.out()));
     const ArvPixelFormat current = arv_camera_get_pixel_format(camera_, error.out());
@@ -427,6 +462,45 @@ StreamCounters Camera::counters() const {
         c.missing_packets = missing;
     }
     return c;
+}
+
+// ---- TriggerWorker ---------------------------------------------------------------------
+
+TriggerWorker::TriggerWorker(std::shared_ptr<Camera> camera) : camera_(std::move(camera)) {
+    thread_ = std::thread([this] { loop(); });
+}
+
+TriggerWorker::~TriggerWorker() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+}
+
+void TriggerWorker::request() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        pending_ = true;
+    }
+    cv_.notify_all();
+}
+
+void TriggerWorker::loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+        cv_.wait(lock, [&] { return stop_ || pending_; });
+        if (stop_) return;
+        pending_ = false;
+        lock.unlock();
+        try {
+            camera_->softwareTrigger();
+        } catch (const std::exception &e) {
+            camera_->markLost(std::string("software trigger unanswered: ") + e.what());
+        }
+        lock.lock();
+    }
 }
 
 } // namespace binocle::gige

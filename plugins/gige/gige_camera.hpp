@@ -15,6 +15,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 namespace binocle::gige {
 
@@ -54,6 +55,13 @@ private:
     std::atomic<int> lent_{0};
 };
 
+// What starts an image: the camera's own clock, a command from the host, or a signal on
+// an input line.
+enum class Trigger { FreeRun, Software, Hardware };
+
+// The `trigger` setting's names: free_run | software | hardware. nullopt for any other.
+std::optional<Trigger> triggerNamed(const std::string &name);
+
 struct CameraSettings {
     std::string id;   // device id or IP address, as written in the YAML
     std::string key;  // the YAML key it came from ("camera_left")
@@ -61,7 +69,7 @@ struct CameraSettings {
     const PixelFormat *format = nullptr;
     std::optional<int64_t> width, height; // unset: keep the camera's
     std::optional<double> exposure_us, gain_db, frame_rate_hz;
-    std::string trigger = "free_run"; // free_run | software | hardware
+    Trigger trigger = Trigger::FreeRun;
     std::string trigger_line = "Line0";
     std::optional<int64_t> packet_size; // unset: the largest the path carries
     std::optional<int64_t> packet_delay_ns;
@@ -122,6 +130,12 @@ private:
         std::shared_ptr<Notifier> notifier;
     };
     void configure();
+    void identify();
+    void configurePixelFormat();
+    void configureImageSize();
+    void configureExposureGainRate();
+    void configureTrigger();
+    void openStream();
     void configureTransport();    // packet size and delay, on the camera
     void configureStreamSocket(); // receive buffer and resend policy, on the stream
     [[noreturn]] void fail(int32_t code, const std::string &what) const;
@@ -141,6 +155,23 @@ private:
     int64_t socketBufferBytes_ = 0, socketBufferLimitBytes_ = 0, packetSize_ = 0;
     bool buffersQueued_ = false;
     std::atomic<bool> acquiring_{false};
+};
+
+// Sends one camera's software triggers from a thread of its own: a camera that is gone
+// takes seconds to fail, and must delay neither grab nor the other camera's trigger.
+class TriggerWorker {
+public:
+    explicit TriggerWorker(std::shared_ptr<Camera> camera);
+    ~TriggerWorker(); // waits for a trigger in flight (bounded by Aravis's timeouts)
+    void request();
+
+private:
+    void loop();
+    std::shared_ptr<Camera> camera_;
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    bool stop_ = false, pending_ = false;
+    std::thread thread_;
 };
 
 } // namespace binocle::gige

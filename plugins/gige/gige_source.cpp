@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The `gige` StereoSource: a stereo rig of two GigE Vision cameras, or one camera that
-// delivers both images side by side, through Aravis 0.8. Pairs are formed by time stamp;
-// a camera that stops answering is reported and reconnected in the background, and no
-// wait lasts longer than grab's timeout. Settings and behaviour: README.md beside this file.
+// delivers both images side by side, through Aravis 0.8. Pairs are formed by time stamp
+// (pairing.hpp); a camera that stops answering is reported and reconnected in the
+// background (reconnection.hpp), and no wait lasts longer than grab's timeout. Settings and
+// behaviour: README.md beside this file.
 #include "gige_camera.hpp"
+#include "gige_slot.hpp"
+#include "pairing.hpp"
 #include "pixel_formats.hpp"
+#include "reconnection.hpp"
 
 #include "common/param_check.hpp"
 
@@ -12,16 +16,11 @@
 #include <opencv2/core.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <deque>
 #include <fstream>
-#include <map>
 #include <optional>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 namespace binocle::gige {
@@ -46,78 +45,6 @@ std::string formatMs(double ms) {
     s << std::fixed << ms;
     return s.str();
 }
-
-double msBetween(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-const char *statusName(ArvBufferStatus s) {
-    switch (s) {
-    case ARV_BUFFER_STATUS_SUCCESS: return "success";
-    case ARV_BUFFER_STATUS_CLEARED: return "cleared";
-    case ARV_BUFFER_STATUS_TIMEOUT: return "timeout";
-    case ARV_BUFFER_STATUS_MISSING_PACKETS: return "missing_packets";
-    case ARV_BUFFER_STATUS_WRONG_PACKET_ID: return "wrong_packet_id";
-    case ARV_BUFFER_STATUS_SIZE_MISMATCH: return "size_mismatch";
-    case ARV_BUFFER_STATUS_FILLING: return "filling";
-    case ARV_BUFFER_STATUS_ABORTED: return "aborted";
-    default: return "unknown";
-    }
-}
-
-// A buffer taken from a stream, waiting for its partner.
-struct Pending {
-    ArvBuffer *buffer = nullptr;
-    std::shared_ptr<BufferHome> home;
-    int64_t timestamp_ns = 0;
-    uint64_t frame_id = 0;
-};
-
-// Sends one camera's software triggers from a thread of its own: a camera that is gone
-// takes seconds to fail, and must delay neither grab nor the other camera's trigger.
-class TriggerWorker {
-public:
-    explicit TriggerWorker(std::shared_ptr<Camera> camera) : camera_(std::move(camera)) {
-        thread_ = std::thread([this] { loop(); });
-    }
-    ~TriggerWorker() { // waits for a trigger in flight (bounded by Aravis's timeouts)
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            stop_ = true;
-        }
-        cv_.notify_all();
-        thread_.join();
-    }
-    void request() {
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            pending_ = true;
-        }
-        cv_.notify_all();
-    }
-
-private:
-    void loop() {
-        std::unique_lock<std::mutex> lock(mutex_);
-        for (;;) {
-            cv_.wait(lock, [&] { return stop_ || pending_; });
-            if (stop_) return;
-            pending_ = false;
-            lock.unlock();
-            try {
-                camera_->softwareTrigger();
-            } catch (const std::exception &e) {
-                camera_->markLost(std::string("software trigger unanswered: ") + e.what());
-            }
-            lock.lock();
-        }
-    }
-    std::shared_ptr<Camera> camera_;
-    std::mutex mutex_;
-    std::condition_variable cv_;
-    bool stop_ = false, pending_ = false;
-    std::thread thread_;
-};
 
 } // namespace
 
@@ -168,12 +95,12 @@ public:
         if (!format)
             throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "gige: pixel_format = " + p.string("pixel_format") +
                                                           ": not supported (supported: " + supportedPixelFormats() + ")");
-        trigger_ = p.string("trigger");
+        const std::optional<Trigger> trigger = triggerNamed(p.string("trigger"));
+        if (!trigger)
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "gige: trigger = " + p.string("trigger") + ": expected free_run, software or hardware");
+        trigger_ = *trigger;
         toleranceNs_ = static_cast<int64_t>(p.real("pair_tolerance_ms") * 1e6);
         deviceTime_ = p.string("timestamp") == "device";
-        lostAfter_ = milliseconds(p.integer("lost_after_ms"));
-        reconnect_ = p.boolean("reconnect");
-        retryInterval_ = milliseconds(p.integer("retry_interval_ms"));
         if (!p.string("calibration").empty()) calibration_ = readFile(p.string("calibration"));
 
         CameraSettings base;
@@ -239,46 +166,48 @@ public:
         width_ = first.width();
         height_ = first.height();
         for (const auto &slot : slots_) warnTransport(*slot->camera);
-        if (trigger_ == "software")
+        if (trigger_ == Trigger::Software)
             for (auto &slot : slots_) slot->trigger = std::make_unique<TriggerWorker>(slot->camera);
+        pairing_ = std::make_unique<Pairing>(trigger_, sideBySide_, toleranceNs_, deviceTime_);
+        ReconnectionSettings r;
+        r.reconnect = reconnect_ = p.boolean("reconnect");
+        r.retryInterval = milliseconds(p.integer("retry_interval_ms"));
+        r.lostAfter = milliseconds(p.integer("lost_after_ms"));
+        r.trigger = trigger_;
+        r.width = width_;
+        r.height = height_;
+        reconnection_ = std::make_unique<Reconnection>(r, slots_, *pairing_, notifier_, host_, running_);
     }
 
     ~GigeSource() override {
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            closing_ = true;
-        }
-        wake_.notify_all();
-        for (auto &slot : slots_) slot->trigger.reset();
-        for (auto &t : background_) t.join(); // closes lost cameras (may wait for Aravis timeouts)
+        reconnection_->shutdown(); // closes lost cameras (may wait for Aravis timeouts)
         for (auto &slot : slots_) {
-            dropPending(*slot, false);
+            pairing_->dropPending(*slot, false);
             if (slot->camera) slot->camera->stop();
             slot->camera.reset();
-            std::lock_guard<std::mutex> lock(mutex_);
-            slot->reconnected.reset();
+            slot->reconnected.reset(); // the background threads are gone
         }
     }
 
     void start() override {
-        adoptReconnected();
+        reconnection_->adoptReconnected();
         for (auto &slot : slots_) {
             if (!slot->camera) continue;
             slot->camera->start();
-            if (trigger_ == "free_run") slot->awaitingSince = Clock::now();
+            if (trigger_ == Trigger::FreeRun) slot->awaitingSince = Clock::now();
         }
         running_ = true;
-        triggerOutstanding_ = false;
+        pairing_->forgetTrigger();
     }
 
     void stop() override {
         running_ = false;
         for (auto &slot : slots_) {
-            dropPending(*slot, true); // every image received is accounted for: paired or unpaired
+            pairing_->dropPending(*slot, true); // every image received is accounted for: paired or unpaired
             if (slot->camera) slot->camera->stop();
             slot->awaitingSince.reset();
         }
-        triggerOutstanding_ = false;
+        pairing_->forgetTrigger();
     }
 
     std::unique_ptr<sdk::Frame> grab(int32_t timeout_ms) override {
@@ -287,26 +216,26 @@ public:
         const Clock::time_point deadline = timeout_ms < 0 ? Clock::time_point::max() : begin + milliseconds(timeout_ms);
         for (;;) {
             const uint64_t seen = notifier_->events();
-            adoptReconnected();
+            reconnection_->adoptReconnected();
             const Clock::time_point now = Clock::now();
 
             // Cameras that are gone: a fresh loss is reported at once; while a camera is
             // away, grab waits (within its timeout) for the reconnection.
-            std::string fresh = detectLoss(now);
+            std::string fresh = reconnection_->detectLoss(now);
             if (!fresh.empty()) throw Error(BINOCLE_ERR_DEVICE, fresh);
-            if (anyDisconnected()) {
+            if (reconnection_->anyDisconnected()) {
                 // The cameras still there keep streaming: take their images (they have no
                 // partner) so that they count as alive and their buffers go round.
-                collect(now);
-                for (auto &slot : slots_) dropPending(*slot, true);
-                if (!reconnect_ || now >= deadline) throw Error(BINOCLE_ERR_DEVICE, disconnectedMessage());
+                pairing_->collect(slots_, now);
+                for (auto &slot : slots_) pairing_->dropPending(*slot, true);
+                if (!reconnect_ || now >= deadline) throw Error(BINOCLE_ERR_DEVICE, reconnection_->disconnectedMessage());
                 notifier_->wait(seen, std::min(deadline, now + milliseconds(50)));
                 continue;
             }
 
-            if (trigger_ == "software" && !triggerOutstanding_) requestTrigger(now);
-            collect(now);
-            if (auto frame = pair()) return frame;
+            if (trigger_ == Trigger::Software && !pairing_->triggerOutstanding()) pairing_->requestTrigger(slots_, now);
+            pairing_->collect(slots_, now);
+            if (std::optional<Pair> pair = pairing_->next(slots_)) return makeFrame(*pair);
             if (Clock::now() >= deadline) throw Error(BINOCLE_ERR_TIMEOUT, timeoutMessage(timeout_ms));
             // Stream callbacks may fire just before the buffer is queued: look again soon.
             notifier_->wait(seen, std::min(deadline, Clock::now() + milliseconds(5)));
@@ -320,8 +249,8 @@ public:
         s << "live: true\n"; // frames come on the cameras' clock: the host defaults to the latest policy
         s << "layout: " << (sideBySide_ ? "side_by_side" : "two_cameras") << "\n";
         s << "frames: " << sequence_ << "\n";
-        s << "unpaired: " << unpaired_ << "\n";
-        s << "reconnections: " << reconnections_ << "\n";
+        s << "unpaired: " << pairing_->unpaired() << "\n";
+        s << "reconnections: " << reconnection_->reconnections() << "\n";
         s << "cameras:\n";
         for (const auto &slot : slots_) {
             StreamCounters c = slot->retired;
@@ -331,8 +260,8 @@ public:
             s << "    connected: " << (slot->camera ? "true" : "false") << "\n";
             s << "    images: " << slot->images << "\n";
             s << "    unpaired: " << slot->unpaired << "\n";
-            s << "    incomplete_images: " << incompleteImages(*slot) << "\n";
-            s << "    skipped_frame_ids: " << skippedIds(*slot) << "\n";
+            s << "    incomplete_images: " << Pairing::incompleteImages(*slot) << "\n";
+            s << "    skipped_frame_ids: " << Pairing::skippedIds(*slot) << "\n";
             s << "    completed_buffers: " << c.completed << "\n";
             s << "    failed_buffers: " << c.failed << "\n";
             s << "    underrun_buffers: " << c.underruns << "\n";
@@ -383,24 +312,6 @@ public:
     }
 
 private:
-    struct Slot {
-        CameraSettings settings;
-        std::shared_ptr<Camera> camera;    // null while the camera is away
-        std::shared_ptr<Camera> reconnected; // set by the background thread (mutex_)
-        std::deque<Pending> pending;
-        std::optional<Clock::time_point> awaitingSince; // an image is due since then
-        int64_t lastSequence = -1;                      // last frame this camera took part in
-        std::string lostWhy;                            // why it is away
-        int attempts = 0;                               // reconnection attempts (mutex_)
-        std::string lastAttemptError;                   // (mutex_)
-        StreamCounters retired;                         // counters of closed streams
-        uint64_t images = 0, losses = 0, unpaired = 0, idGap = 0;
-        std::optional<uint64_t> lastFrameId; // of the current camera
-        std::map<std::string, uint64_t> failures;
-        std::unique_ptr<TriggerWorker> trigger; // software trigger: of the current camera
-        bool answered = false;                  // software trigger: an image came for the last one
-    };
-
     // The kernel silently caps a socket's receive buffer at net.core.rmem_max.
     void warnTransport(const Camera &c) const {
         if (c.socketBufferLimitBytes() > 0 && c.socketBufferBytes() > c.socketBufferLimitBytes())
@@ -410,326 +321,10 @@ private:
                           std::to_string(c.socketBufferBytes()) + ")");
     }
 
-    static std::string sizeText(const Camera &c) {
-        return std::to_string(c.width()) + "x" + std::to_string(c.height()) + " " + c.format().name;
-    }
-
-    std::string afterFrame(const Slot &slot) const {
-        return slot.lastSequence < 0 ? "before the first frame" : "after frame " + std::to_string(slot.lastSequence);
-    }
-
-    bool anyDisconnected() const {
-        for (const auto &slot : slots_)
-            if (!slot->camera) return true;
-        return false;
-    }
-
-    void noteUnpaired(Slot &slot) {
-        ++unpaired_;
-        ++slot.unpaired;
-    }
-
-    // Frame ids between two complete images, not counted otherwise: the camera numbered
-    // them but they never left the stream (every packet lost, or no free buffer). Only
-    // complete images' ids are trusted: a buffer that lost packets may carry any id.
-    // GVSP 1.x ids run 1..65535, then wrap.
-    static void countIdGap(Slot &slot, uint64_t id) {
-        if (id == 0) return;
-        if (slot.lastFrameId) {
-            const uint64_t last = *slot.lastFrameId;
-            if (id > last) slot.idGap += id - last - 1;
-            else if (last - id > 32768 && last <= 65535) slot.idGap += (65535 - last) + (id - 1);
-            else return; // an older image given up late, or a repeat: nothing skipped, `last` stays
-        }
-        slot.lastFrameId = id;
-    }
-
-    static uint64_t incompleteImages(const Slot &slot) {
-        uint64_t n = 0;
-        for (const auto &[name, count] : slot.failures) n += count;
-        return n;
-    }
-
-    // Ids skipped between complete images, less the incomplete images among them.
-    static uint64_t skippedIds(const Slot &slot) {
-        const uint64_t incomplete = incompleteImages(slot);
-        return slot.idGap > incomplete ? slot.idGap - incomplete : 0;
-    }
-
-    void dropPending(Slot &slot, bool countUnpaired) {
-        for (auto &p : slot.pending) {
-            p.home->push(p.buffer);
-            if (countUnpaired) noteUnpaired(slot);
-        }
-        slot.pending.clear();
-    }
-
-    // Finds cameras that went away since the last look; hands each to a background thread
-    // (closing it waits for Aravis timeouts) and returns the message to report, or "".
-    std::string detectLoss(Clock::time_point now) {
-        std::string message;
-        for (auto &slotPtr : slots_) {
-            Slot &slot = *slotPtr;
-            if (!slot.camera) continue;
-            std::string why = slot.camera->lostReason();
-            if (why.empty() && slot.awaitingSince && now - *slot.awaitingSince > lostAfter_)
-                why = "no image for " + formatMs(msBetween(*slot.awaitingSince, now)) + " ms";
-            if (why.empty()) continue;
-            slot.lostWhy = why;
-            slot.camera->markLost(why); // from now on nothing talks to it
-            ++slot.losses;
-            slot.retired += slot.camera->counters();
-            const std::string label = slot.camera->label();
-            loseCamera(slot);
-            message += (message.empty() ? "gige: " : "; ") + std::string("camera ") + label + " stopped answering " +
-                       afterFrame(slot) + " (" + why + ")";
-        }
-        if (message.empty()) return message;
-        for (auto &slot : slots_) {
-            dropPending(*slot, true);
-            // No trigger goes out while a camera is away: the others owe no image.
-            if (trigger_ == "software") slot->awaitingSince.reset();
-        }
-        triggerOutstanding_ = false;
-        return message + (reconnect_ ? "; reconnecting every " + std::to_string(retryInterval_.count()) + " ms" : "; reconnect is off");
-    }
-
-    void loseCamera(Slot &slot) {
-        dropPending(slot, false);
-        std::shared_ptr<Camera> dead = std::move(slot.camera);
-        slot.awaitingSince.reset();
-        Slot *s = &slot;
-        std::lock_guard<std::mutex> lock(mutex_);
-        s->attempts = 0;
-        s->lastAttemptError.clear();
-        // Closing a camera that is gone waits for control-channel timeouts (its trigger
-        // thread too, when a trigger is in flight): never in grab.
-        background_.emplace_back([dead = std::move(dead), trigger = std::move(s->trigger)]() mutable {
-            trigger.reset();
-            dead.reset();
-        });
-        if (reconnect_) background_.emplace_back([this, s] { reconnectLoop(*s); });
-    }
-
-    void reconnectLoop(Slot &slot) {
-        std::unique_lock<std::mutex> lock(mutex_);
-        while (!closing_) {
-            wake_.wait_for(lock, retryInterval_, [&] { return closing_; });
-            if (closing_) return;
-            ++slot.attempts;
-            const CameraSettings settings = slot.settings;
-            lock.unlock();
-            std::shared_ptr<Camera> camera;
-            std::string error;
-            try {
-                camera = std::make_shared<Camera>(settings, notifier_, false);
-                if (camera->width() != width_ || camera->height() != height_)
-                    throw Error(BINOCLE_ERR_DEVICE, "gige: camera " + camera->label() + " is back with " + sizeText(*camera) +
-                                                        " images instead of " + std::to_string(width_) + "x" + std::to_string(height_));
-                if (running_) camera->start();
-            } catch (const std::exception &e) {
-                error = e.what();
-                camera.reset();
-            }
-            lock.lock();
-            if (camera) {
-                slot.reconnected = std::move(camera);
-                lock.unlock();
-                notifier_->notify();
-                return;
-            }
-            slot.lastAttemptError = error;
-        }
-    }
-
-    // Takes in cameras the background threads have reopened.
-    void adoptReconnected() {
-        bool any = false;
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            for (auto &slot : slots_) {
-                if (!slot->reconnected) continue;
-                slot->camera = std::move(slot->reconnected);
-                slot->lastFrameId.reset(); // a reopened camera numbers its frames anew
-                if (trigger_ == "software") slot->trigger = std::make_unique<TriggerWorker>(slot->camera);
-                host_.info("gige: camera " + slot->camera->label() + " is back (" + std::to_string(slot->attempts) +
-                           " attempt(s)); streaming again");
-                ++reconnections_;
-                any = true;
-            }
-        }
-        if (!any) return;
-        const Clock::time_point now = Clock::now();
-        for (auto &slot : slots_) {
-            dropPending(*slot, true);
-            if (!slot->camera) continue;
-            if (running_ && !slot->camera->acquiring()) slot->camera->start(); // start() raced the reopening
-            if (!running_) slot->camera->stop();
-            if (running_ && trigger_ == "free_run") slot->awaitingSince = now;
-        }
-        triggerOutstanding_ = false;
-    }
-
-    std::string disconnectedMessage() {
-        std::string message;
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (const auto &slot : slots_) {
-            if (slot->camera) continue;
-            message += (message.empty() ? "gige: " : "; ") + std::string("camera ") + slot->settings.id + " (" + slot->settings.role +
-                       ") is disconnected since " +
-                       (slot->lastSequence < 0 ? std::string("the start") : "frame " + std::to_string(slot->lastSequence)) + " (" +
-                       slot->lostWhy + ")";
-            if (reconnect_)
-                message += "; reconnecting every " + std::to_string(retryInterval_.count()) + " ms, " + std::to_string(slot->attempts) +
-                           " attempt(s)" + (slot->lastAttemptError.empty() ? "" : ", last: " + slot->lastAttemptError);
-            else
-                message += "; reconnect is off";
-        }
-        return message;
-    }
-
-    void requestTrigger(Clock::time_point now) {
-        for (auto &slot : slots_) {
-            dropPending(*slot, true);
-            slot->answered = false;
-            slot->trigger->request();
-            if (!slot->awaitingSince) slot->awaitingSince = now;
-        }
-        triggerOutstanding_ = true;
-    }
-
-    // Takes every finished buffer out of the streams.
-    void collect(Clock::time_point now) {
-        for (auto &slotPtr : slots_) {
-            Slot &slot = *slotPtr;
-            if (!slot.camera) continue;
-            Camera &camera = *slot.camera;
-            while (ArvBuffer *buffer = camera.tryPop()) {
-                const ArvBufferStatus status = arv_buffer_get_status(buffer);
-                if (trigger_ == "software") {
-                    // Exactly one image per camera answers a trigger: anything more is stale.
-                    if (slot.answered) {
-                        camera.home()->push(buffer);
-                        if (status == ARV_BUFFER_STATUS_SUCCESS) noteUnpaired(slot);
-                        continue;
-                    }
-                    slot.answered = true;
-                    slot.awaitingSince.reset();
-                } else if (trigger_ == "free_run") {
-                    slot.awaitingSince = now;
-                }
-                if (status == ARV_BUFFER_STATUS_SUCCESS) countIdGap(slot, arv_buffer_get_frame_id(buffer));
-                if (status != ARV_BUFFER_STATUS_SUCCESS) {
-                    ++slot.failures[statusName(status)];
-                    camera.home()->push(buffer);
-                    continue;
-                }
-                try {
-                    checkImage(camera, buffer);
-                } catch (...) {
-                    if (trigger_ == "software") triggerOutstanding_ = false;
-                    throw;
-                }
-                Pending p;
-                p.buffer = buffer;
-                p.home = camera.home();
-                p.timestamp_ns = static_cast<int64_t>(deviceTime_ ? arv_buffer_get_timestamp(buffer) : arv_buffer_get_system_timestamp(buffer));
-                p.frame_id = arv_buffer_get_frame_id(buffer);
-                slot.pending.push_back(std::move(p));
-                ++slot.images;
-                // A partner that never comes must not hold every buffer of the stream.
-                const size_t keep = std::max<size_t>(1, static_cast<size_t>(slot.settings.buffers / 2));
-                while (slot.pending.size() > keep) {
-                    slot.pending.front().home->push(slot.pending.front().buffer);
-                    slot.pending.pop_front();
-                    noteUnpaired(slot);
-                }
-            }
-        }
-    }
-
-    // Refuses a buffer that does not hold the image the camera was configured for.
-    void checkImage(Camera &camera, ArvBuffer *buffer) {
-        const int w = arv_buffer_get_image_width(buffer), h = arv_buffer_get_image_height(buffer);
-        const ArvPixelFormat pf = arv_buffer_get_image_pixel_format(buffer);
-        size_t size = 0;
-        arv_buffer_get_image_data(buffer, &size);
-        gint xPadding = 0, yPadding = 0;
-        arv_buffer_get_image_padding(buffer, &xPadding, &yPadding);
-        const PixelFormat &f = camera.format();
-        const size_t needed = (static_cast<size_t>(w) * f.bytes_per_pixel + xPadding) * h;
-        if (w == camera.width() && h == camera.height() && pf == f.arv && size >= needed) return;
-        const PixelFormat *got = findPixelFormat(pf);
-        std::ostringstream what;
-        what << "gige: camera " << camera.label() << " sent a " << w << "x" << h << " "
-             << (got ? got->name : ("pixel format 0x" + [&] { std::ostringstream x; x << std::hex << pf; return x.str(); }()))
-             << " image of " << size << " bytes; expected " << camera.width() << "x" << camera.height() << " " << f.name
-             << " (wrong frame size: was the camera reconfigured behind this source's back?)";
-        camera.home()->push(buffer);
-        throw Error(BINOCLE_ERR_DEVICE, what.str());
-    }
-
-    std::unique_ptr<sdk::Frame> pair() {
-        if (trigger_ == "software") return pairTriggered();
-        if (sideBySide_) {
-            Slot &slot = *slots_[0];
-            if (slot.pending.empty()) return nullptr;
-            Pending p = std::move(slot.pending.front());
-            slot.pending.pop_front();
-            return makeFrame({&p}, {&slot});
-        }
-        Slot &l = *slots_[0], &r = *slots_[1];
-        while (!l.pending.empty() && !r.pending.empty()) {
-            const int64_t dt = l.pending.front().timestamp_ns - r.pending.front().timestamp_ns;
-            if (std::llabs(dt) <= toleranceNs_) {
-                Pending a = std::move(l.pending.front()), b = std::move(r.pending.front());
-                l.pending.pop_front();
-                r.pending.pop_front();
-                return makeFrame({&a, &b}, {&l, &r});
-            }
-            lastUnpairedDtNs_ = dt;
-            Slot &older = dt < 0 ? l : r;
-            older.pending.front().home->push(older.pending.front().buffer);
-            older.pending.pop_front();
-            noteUnpaired(older);
-        }
-        return nullptr;
-    }
-
-    // Software trigger: the images that answer one trigger make the pair, once every camera
-    // has answered; a failed image (or time stamps too far apart) drops the others and the
-    // next call triggers again. Time stamps alone could pair images of two triggers sent
-    // within pair_tolerance_ms.
-    std::unique_ptr<sdk::Frame> pairTriggered() {
-        for (const auto &slot : slots_)
-            if (!slot->answered) return nullptr;
-        triggerOutstanding_ = false;
-        bool complete = true;
-        for (const auto &slot : slots_) complete = complete && slot->pending.size() == 1;
-        if (complete && !sideBySide_) {
-            const int64_t dt = slots_[0]->pending.front().timestamp_ns - slots_[1]->pending.front().timestamp_ns;
-            if (std::llabs(dt) > toleranceNs_) {
-                lastUnpairedDtNs_ = dt;
-                complete = false;
-            }
-        }
-        if (!complete) {
-            for (auto &slot : slots_) dropPending(*slot, true);
-            return nullptr;
-        }
-        std::vector<Pending> parts;
-        std::vector<Slot *> owners;
-        for (auto &slot : slots_) {
-            parts.push_back(std::move(slot->pending.front()));
-            slot->pending.clear();
-            owners.push_back(slot.get());
-        }
-        std::vector<Pending *> views;
-        for (auto &p : parts) views.push_back(&p);
-        return makeFrame(views, owners);
-    }
-
-    std::unique_ptr<sdk::Frame> makeFrame(const std::vector<Pending *> &parts, const std::vector<Slot *> &slots) {
+    std::unique_ptr<sdk::Frame> makeFrame(Pair &pair) {
+        std::vector<Pending *> parts;
+        for (auto &p : pair.parts) parts.push_back(&p);
+        const std::vector<Slot *> &slots = pair.slots;
         struct Pixels {
             cv::Mat converted[2];
         };
@@ -790,7 +385,6 @@ private:
             frame->onRelease = [lent = std::move(lent)] {
                 for (const auto &[home, buffer] : lent) home->giveBack(buffer);
             };
-        if (trigger_ == "software") triggerOutstanding_ = false;
         return frame;
     }
 
@@ -802,10 +396,10 @@ private:
             s << (i ? "; " : "") << slot.settings.role << ": " << slot.pending.size() << " image(s) waiting";
             for (const auto &[name, n] : slot.failures) s << ", " << n << " failed buffer(s) " << name;
         }
-        if (trigger_ == "hardware") s << "; waiting for hardware triggers on " << slots_[0]->settings.trigger_line;
-        if (unpaired_ > 0)
-            s << "; " << unpaired_ << " image(s) left unpaired so far, last left/right time stamps "
-              << formatMs(std::abs(static_cast<double>(lastUnpairedDtNs_)) / 1e6) << " ms apart, pair_tolerance_ms "
+        if (trigger_ == Trigger::Hardware) s << "; waiting for hardware triggers on " << slots_[0]->settings.trigger_line;
+        if (pairing_->unpaired() > 0)
+            s << "; " << pairing_->unpaired() << " image(s) left unpaired so far, last left/right time stamps "
+              << formatMs(std::abs(static_cast<double>(pairing_->lastUnpairedDtNs())) / 1e6) << " ms apart, pair_tolerance_ms "
               << formatMs(static_cast<double>(toleranceNs_) / 1e6);
         s << ")";
         return s.str();
@@ -813,27 +407,18 @@ private:
 
     sdk::Host host_;
     std::shared_ptr<Notifier> notifier_;
-    std::vector<std::unique_ptr<Slot>> slots_; // [left, right] or [the side-by-side camera]
+    Slots slots_; // [left, right] or [the side-by-side camera]
     bool sideBySide_ = false;
-    std::string trigger_;
+    Trigger trigger_ = Trigger::FreeRun;
     int64_t toleranceNs_ = 0;
     bool deviceTime_ = false;
-    milliseconds lostAfter_{1000};
     bool reconnect_ = true;
-    milliseconds retryInterval_{1000};
     std::string calibration_;
     int width_ = 0, height_ = 0;
-
     std::atomic<bool> running_{false};
-    bool triggerOutstanding_ = false;
-    uint64_t sequence_ = 0, unpaired_ = 0, reconnections_ = 0;
-    int64_t lastUnpairedDtNs_ = 0;
-
-    // Shared with the background threads.
-    std::mutex mutex_;
-    std::condition_variable wake_;
-    bool closing_ = false;
-    std::vector<std::thread> background_;
+    uint64_t sequence_ = 0;
+    std::unique_ptr<Pairing> pairing_;
+    std::unique_ptr<Reconnection> reconnection_;
 };
 
 } // namespace binocle::gige

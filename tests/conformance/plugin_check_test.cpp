@@ -97,5 +97,36 @@ TEST(PluginCheck, AnUnknownNameSaysWhereItLooked) {
     EXPECT_THAT(r.err, HasSubstr("no file binocle_not_a_plugin.so in the search path (" BINOCLE_TEST_PLUGIN_DIR));
 }
 
+
+TEST(PluginCheck, AnUnknownOrBadSetIsAUsageErrorNamingTheKey) {
+    // Before: 6 of 9 cases skipped and "0 failed", exit 0, for a key the plugin lacks.
+    ProcessResult r = check({"mock_matcher", "--set", "nonsense=1"});
+    ASSERT_TRUE(r.exited) << r.err;
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_THAT(r.err, HasSubstr("--set nonsense=1 refused"));
+    EXPECT_THAT(r.err, HasSubstr("nonsense"));
+    EXPECT_THAT(r.out, Not(HasSubstr("PASS  compute")));
+    r = check({"mock_matcher", "--set", "disparity_px=-3"});
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_THAT(r.err, HasSubstr("disparity_px"));
+    r = check({"mock_matcher", "--set", "mode=sideways"});
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_THAT(r.err, HasSubstr("mode"));
+    r = check({"mock_matcher", "--set", "=1"});
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+}
+
+TEST(PluginCheck, SkippedCasesAreNeverReadAsAPass) {
+    // The mock source ends its stream; frames=0 makes it end at once: cases that need a
+    // frame are skipped, and the summary says that they checked nothing.
+    const ProcessResult r = check({"mock_source", "--set", "frames=0"});
+    ASSERT_TRUE(r.exited) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("SKIP  "));
+    EXPECT_THAT(r.out, HasSubstr("did not run and checked nothing: not a full pass"));
+    const ProcessResult full = check({"mock_matcher"});
+    EXPECT_THAT(full.out, HasSubstr(" 0 failed, 0 skipped\n"));
+    EXPECT_THAT(full.out, Not(HasSubstr("not a full pass")));
+}
+
 } // namespace
 } // namespace binocle::test

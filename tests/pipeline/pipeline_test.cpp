@@ -7,6 +7,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/stage_times.hpp"
 
 #include <gtest/gtest.h>
 
@@ -226,6 +227,74 @@ TEST(Pipeline, LatestFrameObserverSkipsWhileItsConsumerIsBehind) {
     EXPECT_EQ(s->disparity.size(), cv::Size(64, 48));
     EXPECT_EQ(s->cloud.size(), 64u * 48u);
     EXPECT_FALSE(latest.take().has_value());
+}
+
+} // namespace
+} // namespace binocle::test
+
+namespace binocle::test {
+namespace {
+
+TEST(Pipeline, AFrameOfAnotherSizeMidRunIsRefusedNamingTheFrameAndBothSizes) {
+    TempDir dir;
+    Pipeline p(mockRig("  frames: 8\n  grow_after: 4\n"), host());
+    RunOptions o;
+    o.out_dir = dir.str("out");
+    o.progress = false;
+    try {
+        p.run(o);
+        FAIL() << "a 80x48 frame after 64x48 ones must not be processed";
+    } catch (const Error &e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("frame 4 (sequence 4)"), std::string::npos) << what;
+        EXPECT_NE(what.find("80x48"), std::string::npos) << what;
+        EXPECT_NE(what.find("expected 64x48"), std::string::npos) << what;
+    }
+    const Json summary = Json::parse(readTextFile(dir.str("out/summary.json")));
+    EXPECT_EQ(summary["status"], "failed");
+    EXPECT_EQ(summary["frame_count"], 4); // the frames before it are kept
+    EXPECT_EQ(readLines(dir.str("out/frames.jsonl")).size(), 4u);
+}
+
+TEST(Pipeline, SummaryGivesEachStagesMedianAnd95thPercentileTimePerFrame) {
+    TempDir dir;
+    Pipeline p(mockRig("  frames: 20\n"), host());
+    RunOptions o;
+    o.out_dir = dir.str("out");
+    o.progress = false;
+    const Json summary = p.run(o);
+    const Json written = Json::parse(readTextFile(dir.str("out/summary.json")));
+    ASSERT_TRUE(written.contains("stage_seconds_per_frame")) << written.dump(2);
+    const Json &stages = written["stage_seconds_per_frame"];
+    std::vector<std::string> names;
+    for (const auto &[name, t] : stages.items()) {
+        names.push_back(name);
+        EXPECT_EQ(t["frames"], 20) << name;
+        EXPECT_GE(t["median"].get<double>(), 0.0) << name;
+        EXPECT_LE(t["median"].get<double>(), t["p95"].get<double>()) << name;
+        EXPECT_LT(t["p95"].get<double>(), 60.0) << name;
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"acquire", "rectify", "match", "cloud", "transforms", "evaluators", "write"}));
+    EXPECT_EQ(summary["stage_seconds_per_frame"], stages);
+}
+
+TEST(StageTimes, MedianAnd95thPercentileByNearestRank) {
+    StageTimes t;
+    for (int i = 100; i >= 1; --i) t.add(i);
+    EXPECT_EQ(t.count(), 100);
+    EXPECT_EQ(t.quantile(0.5), 50);
+    EXPECT_EQ(t.quantile(0.95), 95);
+    EXPECT_EQ(t.quantile(1.0), 100);
+    EXPECT_EQ(StageTimes().quantile(0.5), 0);
+}
+
+TEST(StageTimes, AnEndlessRunKeepsABoundedUniformSample) {
+    StageTimes t;
+    const int64_t n = 4 * static_cast<int64_t>(StageTimes::kKept);
+    for (int64_t i = 0; i < n; ++i) t.add(static_cast<double>(i) / static_cast<double>(n)); // uniform on [0, 1)
+    EXPECT_EQ(t.count(), n);
+    EXPECT_NEAR(t.quantile(0.5), 0.5, 0.01);
+    EXPECT_NEAR(t.quantile(0.95), 0.95, 0.01);
 }
 
 } // namespace

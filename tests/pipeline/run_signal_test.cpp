@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
-// `binocle run` of an endless simulated rig stopped by SIGINT / SIGTERM: it ends within
+// `binocle run` of an endless simulated rig stopped by SIGINT / SIGTERM / SIGHUP: it ends within
 // 5 s, exits 128 + signal, and leaves summary.json (status interrupted, the frame count),
 // one frames.jsonl line per finished frame, and no temporary file.
 #include "common/test_util.hpp"
 #include "core/atomic_file.hpp"
+#include "spawn_cli.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,11 +14,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <thread>
-
-extern char **environ;
 
 namespace binocle::test {
 namespace {
@@ -34,19 +32,9 @@ size_t lineCount(const std::string &path) {
 void stopWith(int sig) {
     TempDir dir;
     const std::string out = dir.str("out"), rig = std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/sim-videre.yaml";
-    const std::string cli = BINOCLE_CLI, log = dir.str("log");
-    std::vector<std::string> args{cli, "run", rig, "--quiet", "--out", out, "--set", "source.frames=0"};
-    std::vector<char *> argv;
-    for (auto &a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    setenv("BINOCLE_PLUGIN_PATH", BINOCLE_BUILD_PLUGIN_DIR, 1);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
+    const std::string log = dir.str("log");
+    const pid_t pid = spawnCli({"run", rig, "--quiet", "--out", out, "--set", "source.frames=0"}, log);
+    ASSERT_GT(pid, 0);
     // Wait for a few finished frames (the machine may be busy: up to 60 s).
     const auto begin = Clock::now();
     while (lineCount(out + "/frames.jsonl") < 3 && Clock::now() - begin < std::chrono::seconds(60))
@@ -77,6 +65,8 @@ void stopWith(int sig) {
 
 TEST(RunSignal, SigintStopsAnEndlessRunCleanly) { stopWith(SIGINT); }
 TEST(RunSignal, SigtermStopsAnEndlessRunCleanly) { stopWith(SIGTERM); }
+// A closed terminal or a dropped SSH session: like SIGTERM, not a death without summary.
+TEST(RunSignal, SighupStopsAnEndlessRunCleanly) { stopWith(SIGHUP); }
 
 } // namespace
 } // namespace binocle::test

@@ -18,6 +18,7 @@
 #include <csignal>
 #include <fcntl.h>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <sys/wait.h>
 #include <thread>
@@ -237,6 +238,7 @@ TEST(Record, CommandLineErrorsSayWhatIsWrong) {
 pid_t spawnRecorder(const std::string &rig, const std::string &out) {
     const pid_t pid = ::fork();
     if (pid == 0) {
+        ::signal(SIGHUP, SIG_DFL); // as a terminal leaves it, even when the tests run under nohup
         ::setenv("BINOCLE_PLUGIN_PATH", BINOCLE_BUILD_PLUGIN_DIR, 1);
         const int devnull = ::open("/dev/null", O_WRONLY);
         ::dup2(devnull, 2);
@@ -397,6 +399,135 @@ TEST(RecordingWriter, WritesTheLayoutReplayReads) {
     EXPECT_EQ(readFile(dir.str("rec/calibration.yml")), "%YAML:1.0\n---\nimage_width: 8\n");
     EXPECT_EQ(cv::imread(dir.str("rec/right/000019.png"), cv::IMREAD_UNCHANGED).at<uint8_t>(0, 0), 9);
     EXPECT_THROW(binocle::RecordingWriter(dir.str("rec"), "", ""), binocle::Error);
+}
+
+} // namespace
+
+namespace {
+
+// Runs a shell script (bash), capturing its output; the recorder inside gets the build
+// tree's plugins. `timeout -s KILL` turns a hang into exit 137.
+binocle::test::CommandResult runScript(const std::string &script) {
+    return binocle::test::runCommand("BINOCLE_PLUGIN_PATH='" + std::string(BINOCLE_BUILD_PLUGIN_DIR) + "' BINOCLE='" +
+                                     std::string(BINOCLE_CLI) + "' bash -c '" + script + "'");
+}
+
+// Every row of frames.csv names two images that exist and decode; no image lies there
+// without its row. Returns the rows.
+int expectEveryRowWhole(const std::string &rec) {
+    std::ifstream in(rec + "/frames.csv");
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "sequence,timestamp_left_ns,timestamp_right_ns,left,right");
+    int rows = 0;
+    std::set<std::string> listed;
+    while (std::getline(in, line)) {
+        ++rows;
+        std::vector<std::string> cells;
+        std::stringstream s(line);
+        for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+        EXPECT_EQ(cells.size(), 5u) << "row " << rows << ": " << line;
+        if (cells.size() != 5) continue;
+        for (int i = 3; i < 5; ++i) {
+            listed.insert(cells[static_cast<size_t>(i)]);
+            EXPECT_FALSE(cv::imread(rec + "/" + cells[static_cast<size_t>(i)], cv::IMREAD_UNCHANGED).empty())
+                << cells[static_cast<size_t>(i)];
+        }
+    }
+    for (const char *side : {"left", "right"})
+        for (const auto &e : fs::directory_iterator(rec + "/" + side)) {
+            const std::string name = std::string(side) + "/" + e.path().filename().string();
+            EXPECT_TRUE(listed.count(name)) << name << " lies in the recording without its row";
+        }
+    return rows;
+}
+
+// A full disk: a 2 MiB tmpfs in a private mount namespace (root only). The recorder stops
+// with an error naming the disk within the timeout (it used to spin and ignore signals),
+// keeps every pair listed, removes the images no row will name and writes its summary.
+TEST(Record, OnAFullDiskTheRecorderStopsNamingTheDiskAndKeepsEveryListedPair) {
+    if (!haveSim()) GTEST_SKIP() << "sim plugin not built";
+    TempDir dir;
+    binocle::test::writeText(dir.str("rig.yaml"), "name: sim-full-disk\nsource:\n  plugin: sim\n  image_width: 320\n"
+                                                   "  image_height: 240\n  forward_mm_per_frame: 100\n  color: gray\n"
+                                                   "  seed: 3\n  frames: 0\nmatcher: {plugin: sgbm}\n");
+    fs::create_directories(dir.path() / "disk");
+    fs::create_directories(dir.path() / "copy");
+    const std::string disk = dir.str("disk"), rec = disk + "/rec";
+    const binocle::test::CommandResult probe = binocle::test::runCommand("unshare -m true");
+    if (probe.exit_code != 0) GTEST_SKIP() << "cannot make a mount namespace here (needs root): " << probe.output;
+    const auto t0 = std::chrono::steady_clock::now();
+    const binocle::test::CommandResult r = runScript(
+        "unshare -m sh -c \"mount -t tmpfs -o size=2m tmpfs " + disk + " || exit 99; timeout -s KILL 120 \\$BINOCLE record " +
+        dir.str("rig.yaml") + " --out " + rec + " --quiet; echo exit=\\$?; cp -a " + rec + " " + dir.str("copy") + "\"");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (r.exit_code == 99) GTEST_SKIP() << "cannot mount a tmpfs here: " << r.output;
+    EXPECT_NE(r.output.find("exit=1"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("No space left on device"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("the disk holding " + rec), std::string::npos) << r.output;
+    const std::string copy = dir.str("copy/rec");
+    const int rows = expectEveryRowWhole(copy);
+    EXPECT_GT(rows, 0);
+    const auto summary = nlohmann::json::parse(readFile(copy + "/summary.json"));
+    EXPECT_EQ(summary["status"], "error");
+    EXPECT_EQ(summary["pairs_written"], rows);
+    EXPECT_NE(summary["error"].get<std::string>().find("No space left on device"), std::string::npos);
+    EXPECT_EQ(static_cast<int>(replayOf(copy, "gray").size()), rows);
+    std::cout << "[ figures  ] recorder on a 2 MiB disk: stopped after " << rows << " pair(s) in " << seconds << " s\n";
+}
+
+// A file size limit (ulimit -f, SIGXFSZ ignored): frames.csv is the file that reaches it.
+// The index ends with its last whole row and the summary is written.
+TEST(Record, AtTheFileSizeLimitTheIndexKeepsItsLastWholeRow) {
+    TempDir dir;
+    fs::create_directories(dir.path() / "in");
+    for (int i = 0; i < 4; ++i) {
+        cv::Mat l(12, 16, CV_8UC1, cv::Scalar(10 * i)), r(12, 16, CV_8UC1, cv::Scalar(10 * i + 5));
+        cv::imwrite(dir.str("in/left_" + std::to_string(i) + ".png"), l);
+        cv::imwrite(dir.str("in/right_" + std::to_string(i) + ".png"), r);
+    }
+    binocle::test::writeText(dir.str("rig.yaml"), "name: tiny\nsource:\n  plugin: replay\n  left: in/left_*.png\n"
+                                                   "  right: in/right_*.png\n  rate_hz: 200\n  loop: true\n"
+                                                   "matcher: {plugin: sgbm}\n");
+    const std::string rec = dir.str("rec");
+    const binocle::test::CommandResult r =
+        runScript("trap \"\" XFSZ; ulimit -f 4; exec timeout -s KILL 120 \"$BINOCLE\" record " + dir.str("rig.yaml") + " --out " +
+                  rec + " --quiet");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("frames.csv"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("ulimit -f"), std::string::npos) << r.output;
+    const int rows = expectEveryRowWhole(rec);
+    EXPECT_GT(rows, 20);
+    EXPECT_LE(fs::file_size(rec + "/frames.csv"), 4096u);
+    const auto summary = nlohmann::json::parse(readFile(rec + "/summary.json"));
+    EXPECT_EQ(summary["status"], "error");
+    EXPECT_EQ(summary["pairs_written"], rows);
+    EXPECT_EQ(static_cast<int>(replayOf(rec, "gray").size()), rows);
+}
+
+// SIGHUP (the terminal closed) ends a recording as SIGINT does: cleanly, with its summary.
+TEST(Record, SighupEndsTheRecordingWithItsSummary) {
+    TempDir dir;
+    if (haveSim()) {
+        binocle::test::writeText(dir.str("rig.yaml"), simRig(0)); // endless
+    } else {
+        writeColourPairs(dir, 3);
+        binocle::test::writeText(dir.str("rig.yaml"), replayRig(dir, "  loop: true\n"));
+    }
+    const std::string out = dir.str("rec");
+    const pid_t pid = spawnRecorder(dir.str("rig.yaml"), out);
+    ASSERT_GT(pid, 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (countLines(out + "/frames.csv") < 4 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_EQ(::kill(pid, SIGHUP), 0);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 0);
+    const auto summary = nlohmann::json::parse(readFile(out + "/summary.json"));
+    EXPECT_EQ(summary["status"], "interrupted");
+    EXPECT_EQ(summary["pairs_written"].get<int>(), countLines(out + "/frames.csv") - 1);
 }
 
 } // namespace

@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: MIT
+// The matcher kind: its descriptor, its instance in this process, behind a proxy, and in
+// the helper process, and the Matcher wrapper that checks what any of them computes.
+#include "host/isolated_side.hpp"
+#include "host/isolation.hpp"
+#include "host/plugin_instance.hpp"
+#include "host/plugin_kinds.hpp"
+
+#include <cmath>
+#include <spdlog/spdlog.h>
+
+namespace binocle {
+
+namespace {
+
+enum MatcherOp : uint32_t { kCompute = wire::kFirstKindOp, kRange };
+
+} // namespace
+
+// What a matcher instance does, wherever it runs.
+class Matcher::Impl : public InstanceImpl {
+public:
+    // Into `disparity` (CV_32F, left's size), no clean-up of the values.
+    virtual void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) = 0;
+    virtual std::pair<int32_t, int32_t> disparityRange() = 0;
+};
+
+namespace {
+
+class InProcessMatcher : public Matcher::Impl, Created<binocle_matcher_api, binocle_matcher> {
+public:
+    InProcessMatcher(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
+        : Created(record, params, host.get()) {}
+    void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) override {
+        binocle_image l = wrap(left, formatOf(left)), r = wrap(right, formatOf(right));
+        binocle_image d = wrap(disparity, BINOCLE_PIXEL_FLOAT32);
+        const binocle_image expected = d;
+        const int32_t rc = api_->compute(handle_, &l, &r, &d);
+        if (rc != BINOCLE_OK) failed("compute", rc);
+        if (d.data != expected.data || d.width != expected.width || d.height != expected.height ||
+            d.format != expected.format || d.stride_bytes != expected.stride_bytes)
+            failCall(record_, "compute", BINOCLE_ERR_INTERNAL,
+                     "changed the host's disparity image description instead of writing into it");
+    }
+    std::pair<int32_t, int32_t> disparityRange() override {
+        int32_t mn = 0, num = 0;
+        if (!api_->disparity_range) return {0, 0};
+        const int32_t rc = api_->disparity_range(handle_, &mn, &num);
+        if (rc != BINOCLE_OK) failed("disparity_range", rc);
+        return {mn, num};
+    }
+};
+
+class MatcherProxy : public Proxied<Matcher::Impl> {
+public:
+    MatcherProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, host), shared_(record.name, 0) {}
+    void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) override {
+        wire::ComputeRequest c{left.cols, left.rows, left.type(), 0};
+        const size_t rowBytes = left.cols * left.elemSize();
+        c.image_bytes = pageAligned(rowBytes * left.rows);
+        const size_t dispBytes = pageAligned(static_cast<size_t>(left.cols) * left.rows * sizeof(float));
+        const bool done = guarded([&] {
+            uint8_t *base = shared_.reserve(2 * c.image_bytes + dispBytes);
+            // The one copy of the pixels: into the shared mapping the helper process reads.
+            left.copyTo(cv::Mat(left.size(), left.type(), base, rowBytes));
+            right.copyTo(cv::Mat(right.size(), right.type(), base + c.image_bytes, rowBytes));
+            wire::Writer w;
+            wire::put(w, c);
+            call(kCompute, w.data(), &shared_);
+            cv::Mat(left.size(), CV_32F, base + 2 * c.image_bytes).copyTo(disparity);
+        });
+        if (!done) disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
+    }
+    std::pair<int32_t, int32_t> disparityRange() override {
+        std::pair<int32_t, int32_t> range{0, 0};
+        retried([&] {
+            Reply r = call(kRange);
+            range = wire::getRange(r.payload);
+        });
+        return range;
+    }
+
+private:
+    SharedRegion shared_;
+};
+
+class ServedMatcher : public ServedInstance {
+public:
+    ServedMatcher(const PluginRecord &record, const ParamValues &params, HostSink sink) : matcher_(record, params) {
+        matcher_.setSink(std::move(sink));
+    }
+    void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
+        if (op == kRange) return wire::putRange(out, matcher_.disparityRange());
+        if (op != kCompute) throw Error("helper: unknown matcher request " + std::to_string(op));
+        const wire::ComputeRequest c = wire::getComputeRequest(r);
+        if (c.width <= 0 || c.height <= 0 || (c.cv_type != CV_8UC1 && c.cv_type != CV_8UC3))
+            throw Error("helper: malformed compute request");
+        const uint64_t row = static_cast<uint64_t>(c.width) * CV_ELEM_SIZE(c.cv_type);
+        const uint64_t disparityBytes = static_cast<uint64_t>(c.width) * c.height * sizeof(float);
+        if (row * c.height > c.image_bytes || c.image_bytes > m.bytes / 2 || 2 * c.image_bytes + disparityBytes > m.bytes)
+            throw Error("helper: images do not fit the shared memory");
+        cv::Mat left(c.height, c.width, c.cv_type, m.base), right(c.height, c.width, c.cv_type, m.base + c.image_bytes);
+        cv::Mat disparity(c.height, c.width, CV_32F, m.base + 2 * c.image_bytes);
+        disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
+        matcher_.computeInto(left, right, disparity);
+    }
+
+private:
+    Matcher matcher_;
+};
+
+} // namespace
+
+// ---- The wrapper ------------------------------------------------------------------------------
+
+Matcher::Matcher(const PluginRecord &record, const ParamValues &params)
+    : PluginInstanceBase(record), impl_(choose<Impl, InProcessMatcher, MatcherProxy>(record_, params)) {}
+
+Matcher::~Matcher() = default;
+
+cv::Mat Matcher::compute(const cv::Mat &left, const cv::Mat &right) {
+    cv::Mat disparity;
+    compute(left, right, disparity);
+    return disparity;
+}
+
+void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) {
+    if (left.size() != right.size() || left.type() != right.type())
+        throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
+    disparity.create(left.size(), CV_32F);
+    disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
+    impl_->compute(left, right, disparity);
+    // A disparity is at most the image width; inf, NaN or 1e30 would become cloud points.
+    const float limit = static_cast<float>(disparity.cols);
+    uint64_t bad = 0;
+    for (int y = 0; y < disparity.rows; ++y) {
+        float *row = disparity.ptr<float>(y);
+        for (int x = 0; x < disparity.cols; ++x)
+            if (!std::isfinite(row[x]) || row[x] > limit) {
+                row[x] = BINOCLE_INVALID_DISPARITY;
+                ++bad;
+            }
+    }
+    if (bad) {
+        invalidated_ += bad;
+        if (!warnedInvalid_)
+            spdlog::warn("matcher plugin '{}': {} disparities not finite or beyond the image width ({} px) made invalid "
+                         "(counted; further frames at debug level)", record_.name, bad, disparity.cols);
+        else
+            spdlog::debug("matcher plugin '{}': {} disparities not finite or absurd made invalid ({} so far)", record_.name,
+                          bad, invalidated_);
+        warnedInvalid_ = true;
+    }
+}
+
+void Matcher::computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) { impl_->compute(left, right, disparity); }
+
+std::pair<int32_t, int32_t> Matcher::disparityRange() { return impl_->disparityRange(); }
+
+// ---- The descriptor ---------------------------------------------------------------------------
+
+const PluginKind &matcherKind() {
+    using T = binocle_matcher_api;
+    static const PluginKind kind = [] {
+        PluginKind k = tableKind<T>(BINOCLE_KIND_MATCHER, "matcher", "matcher", false);
+        k.versions = {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}};
+        k.entries.push_back({"compute", offsetof(T, compute), true, kCompute});
+        k.entries.push_back({"disparity_range", offsetof(T, disparity_range), false, kRange});
+        k.lostOnRestart = "this frame has no disparity";
+        k.serve = &serveAs<ServedMatcher>;
+        return k;
+    }();
+    return kind;
+}
+
+} // namespace binocle

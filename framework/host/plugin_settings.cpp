@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: MIT
+// Checks of a plugin's settings table (names, types, defaults), apart from loading: the
+// settings checker's home in the host.
+#include "host/plugin_host.hpp"
+#include "host/plugin_name.hpp"
+
+#include <binocle/settings.hpp>
+
+#include <map>
+#include <string>
+
+namespace binocle {
+
+// ---- Settings tables --------------------------------------------------------------------
+
+namespace {
+
+// Why `text` is not a valid value of setting `d`, or "" when it is: the SDK's settings
+// checker, the one the rig validation (config/) uses, applied to the plugin's own default.
+std::string defaultProblem(const binocle_param_desc &d, const std::string &text) {
+    sdk::SettingValue v;
+    return sdk::readSetting(d, text, v).rule;
+}
+
+} // namespace
+
+std::string settingsTableProblem(const binocle_param_desc *params, int32_t count) {
+    if (count < 0 || count > 1000 || (count > 0 && !params))
+        return "a garbage settings table (count " + std::to_string(count) + ")";
+    std::map<std::string, int32_t> seen;
+    for (int32_t i = 0; i < count; ++i) {
+        const auto &d = params[i];
+        const std::string at = "setting #" + std::to_string(i) + " '" + (d.name ? d.name : "(null)") + "'";
+        if (!validName(d.name)) return at + ": invalid name (expected [a-z0-9_]+, e.g. window_px)";
+        if (d.type < BINOCLE_PARAM_BOOL || d.type > BINOCLE_PARAM_DOUBLE_LIST)
+            return at + ": unknown type " + std::to_string(d.type) + " (expected a BINOCLE_PARAM_* value)";
+        if (auto [it, fresh] = seen.emplace(d.name, i); !fresh)
+            return at + ": the name is declared twice (also setting #" + std::to_string(it->second) + ")";
+        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && d.min > d.max)
+            return at + ": min " + sdk::settingNumberText(d.min) + " is above max " + sdk::settingNumberText(d.max);
+        if (d.type == BINOCLE_PARAM_ENUM && (!d.choices || !*d.choices)) return at + ": an enum without choices";
+        if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED) continue;
+        if (!d.default_value) return at + ": no default, and not flagged BINOCLE_PARAM_FLAG_REQUIRED";
+        if (std::string why = defaultProblem(d, d.default_value); !why.empty())
+            return at + ": default '" + d.default_value + "' " + why;
+    }
+    return "";
+}
+
+} // namespace binocle
