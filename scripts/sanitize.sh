@@ -15,13 +15,9 @@ dir="${BINOCLE_SANITIZE_BUILD_DIR:-build-sanitize}"
 seconds="${BINOCLE_FUZZ_SECONDS:-15}"
 jobs="$(nproc)"
 start=$(date +%s)
-# As scripts/build.sh: ccache hashes paths relative to the checkout.
-export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
+# ccache (when installed), as scripts/build.sh: scripts/ccache-env.sh.
+source scripts/ccache-env.sh
 if [ ! -f "$dir/build.ninja" ]; then
-  launcher=()
-  if command -v ccache >/dev/null 2>&1; then
-    launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  fi
   # -O0 -g1: half the compile time of -O1 (measured: 4.5 vs 8.8 CPU-s for a typical
   # translation unit), which is what CI's budget is short of; line tables for the reports.
   cmake -S . -B "$dir" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \

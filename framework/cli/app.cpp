@@ -2,11 +2,14 @@
 // The `binocle` command line as one CLI11 app: registry, global options, shared helpers.
 #include "cli/command.hpp"
 
+#include "input/numbers.hpp"
+#include "input/text.hpp"
+
 #include <binocle/abi.h>
 
-#include <cerrno>
+#include <climits>
 #include <cmath>
-#include <cstdlib>
+#include <functional>
 #include <filesystem>
 
 namespace binocle::cli {
@@ -69,30 +72,79 @@ void addRigArgs(CLI::App &app, RigArgs &args, bool required) {
 }
 
 RigConfig loadRig(const RigArgs &args, const PluginHost &host) {
-    std::vector<Override> overrides;
-    for (const auto &s : args.overrides) overrides.push_back(Override::parse(s));
-    return loadRig(args.file, overrides, host);
+    try {
+        std::vector<Override> overrides;
+        for (const auto &s : args.overrides) overrides.push_back(Override::parse(s));
+        return loadRig(args.file, overrides, host);
+    } catch (const OverrideError &e) {
+        throw UsageError(e.what()); // a bad --set is a bad value on the command line: exit 2
+    }
 }
 
-CLI::Validator atLeast(long long min) {
+namespace {
+
+// A whole number by the one number reader (binocle/numbers.hpp), within [min, max]. The
+// text CLI11 then converts is plain decimal, so its own base detection ("010" -> 8,
+// "0x10" -> 16) never sees a prefix or a leading zero.
+CLI::Validator wholeNumberValidator(long long min, long long max, std::string expected) {
     return CLI::Validator(
-        [min](std::string &text) -> std::string {
-            errno = 0;
-            char *end = nullptr;
-            const long long v = std::strtoll(text.c_str(), &end, 10);
-            if (text.empty() || *end != '\0' || errno == ERANGE || v < min)
-                return "'" + text + "': expected a whole number >= " + std::to_string(min);
+        [min, max, expected](std::string &text) -> std::string {
+            int64_t v = 0;
+            std::string why;
+            if (!input::parseInteger(text, v, &why) || v < min || v > max)
+                return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
             return "";
         },
         "");
 }
 
-CLI::Validator positiveNumber() {
+// A real number by the one number reader: decimal, finite, no hexadecimal float.
+CLI::Validator numberValidator(std::function<bool(double)> fits, std::string expected) {
     return CLI::Validator(
-        [](std::string &text) -> std::string {
-            char *end = nullptr;
-            const double v = std::strtod(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0)) return "'" + text + "': expected a number > 0";
+        [fits = std::move(fits), expected](std::string &text) -> std::string {
+            double v = 0;
+            std::string why;
+            if (!input::parseReal(text, v, &why) || !fits(v))
+                return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
+            return "";
+        },
+        "");
+}
+
+} // namespace
+
+CLI::Validator atLeast(long long min) {
+    return wholeNumberValidator(min, LLONG_MAX, "a whole number >= " + std::to_string(min));
+}
+
+CLI::Validator wholeNumber() { return wholeNumberValidator(LLONG_MIN, LLONG_MAX, "a whole number"); }
+
+CLI::Validator wholeNumberIn(long long min, long long max) {
+    return wholeNumberValidator(min, max, "a whole number " + std::to_string(min) + ".." + std::to_string(max));
+}
+
+CLI::Validator positiveNumber() {
+    return numberValidator([](double v) { return v > 0; }, "a number > 0");
+}
+
+CLI::Validator decimalNumber() {
+    return numberValidator([](double) { return true; }, "a decimal number");
+}
+
+CLI::Validator wholeNumbers(char separator, long long min) {
+    return CLI::Validator(
+        [separator, min](std::string &text) -> std::string {
+            const std::string expected = "whole numbers >= " + std::to_string(min) + " separated by '" + separator + "'";
+            size_t start = 0;
+            while (start <= text.size()) {
+                size_t end = text.find(separator, start);
+                if (end == std::string::npos) end = text.size();
+                int64_t v = 0;
+                std::string why;
+                if (!input::parseInteger(std::string_view(text).substr(start, end - start), v, &why) || v < min)
+                    return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
+                start = end + 1;
+            }
             return "";
         },
         "");

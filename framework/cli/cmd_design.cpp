@@ -28,14 +28,26 @@ namespace {
 
 struct DesignArgs {
     std::string range, band, lenses = method::kVidereLensesMm, baselines = "100:200:10";
-    double pixel_pitch_um = method::kViderePixelPitchUm, camera_height_mm = 1500, inclination_deg = 0;
+    // The head's sensor and matcher, and its pose (method's one head description);
+    // each candidate configures its baseline and lens.
+    method::StereoDesign head = method::videreHead();
     double panel_width_mm = 2500, panel_height_mm = 2000;
-    int image_width = method::kVidereImageWidthPx, image_height = method::kVidereImageHeightPx, num_disparities = 64;
     int top = 10, simulate_count = 12;
     bool simulate = false, quiet = false;
     std::string rig, out;
     std::string predictors_from, predictor; // empty: the shipped file; the best of it
 };
+
+// Candidates are ranked in memory and each is printed to the CSV once per range: more
+// than this many baselines (or baseline x lens pairs) is a typo, not a design question.
+constexpr size_t kMaxBaselines = 100000;
+constexpr size_t kMaxCandidates = 1000000;
+
+std::string num(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
 
 std::vector<double> numberList(const std::string &option, const std::string &text) {
     std::vector<double> out;
@@ -57,6 +69,11 @@ std::vector<double> baselines(const std::string &text) {
     std::stringstream ss(text);
     for (std::string item; std::getline(ss, item, ':');) p.push_back(numberList("--baselines", item).at(0));
     if (p.size() != 3 || !(p[2] > 0) || p[1] < p[0]) throw UsageError("--baselines " + text + ": expected MIN:MAX:STEP in mm, e.g. 100:200:10");
+    // Counted before anything is made: 1:1e9:1 would otherwise fill the memory.
+    const double count = std::floor((p[1] - p[0]) / p[2] + 1e-9) + 1;
+    if (!(count <= static_cast<double>(kMaxBaselines)))
+        throw UsageError("--baselines " + text + ": " + std::to_string(static_cast<long long>(std::min(count, 9e18))) +
+                         " baselines; at most " + std::to_string(kMaxBaselines) + " (use a larger STEP)");
     std::vector<double> out;
     for (double b = p[0]; b <= p[1] + 1e-9; b += p[2]) out.push_back(b);
     return out;
@@ -70,7 +87,8 @@ struct Candidate {
     double eta_3d = NAN;                   // --simulate
 };
 
-int design(const DesignArgs &args) {
+// The target ranges: --range's list, or five across --band.
+std::vector<double> targetRanges(const DesignArgs &args) {
     std::vector<double> ranges;
     if (!args.range.empty()) ranges = numberList("--range", args.range);
     if (!args.band.empty()) {
@@ -81,25 +99,12 @@ int design(const DesignArgs &args) {
     if (ranges.empty()) throw UsageError("give a target: --range 6000 (mm) or --band 5000,12000");
     for (double r : ranges)
         if (!(r > 0)) throw UsageError("--range: " + std::to_string(r) + " mm: expected a positive range");
-    const std::vector<double> lenses = numberList("--lenses", args.lenses);
-    const std::vector<double> bases = baselines(args.baselines);
-    method::StereoDesign head;
-    head.pixel_pitch_um = args.pixel_pitch_um;
-    head.image_width_px = args.image_width;
-    head.image_height_px = args.image_height;
-    head.num_disparities = args.num_disparities;
-    head.camera_height_mm = args.camera_height_mm;
-    head.inclination_deg = args.inclination_deg;
-    method::PanelPlacement panel;
-    panel.width_mm = args.panel_width_mm;
-    panel.height_mm = args.panel_height_mm;
-    for (double v : lenses)
-        if (!(v > 0)) throw UsageError("--lenses: focal lengths must be positive mm");
-    for (double v : bases)
-        if (!(v > 0)) throw UsageError("--baselines: baselines must be positive mm");
+    return ranges;
+}
 
-    // The predictor to rank with: the one whose Spearman rho with measured η3D is
-    // highest (by default on the simulated E1 with ten repeats; --predictor forces one).
+// The predictor to rank with: the one whose Spearman rho with measured η3D is highest
+// (by default on the simulated E1 with ten repeats; --predictor forces one).
+std::string choosePredictor(const DesignArgs &args) {
     const PredictorChoice choice = loadPredictorChoice(args.predictors_from.empty() ? dataFile("configs/predictors/e1-sim.json") : args.predictors_from);
     const std::string predictor = args.predictor.empty() ? choice.best : args.predictor;
     const auto &names = method::predictorNames();
@@ -113,15 +118,41 @@ int design(const DesignArgs &args) {
     for (const auto &[name, rho] : choice.rho)
         spdlog::info("  {:<20} {:6.3f}{}", name, rho, name == predictor ? "   <- ranks" : "");
     spdlog::info("design: ranking by {} ({})", predictor, predictor == choice.best ? "the highest rho" : "chosen with --predictor");
+    return predictor;
+}
 
+// Every (B, f) with its figures at each range, ranked: configurations that see the whole
+// panel and whose search reaches the range first, then the predictor's score at the
+// band's worst range, then the finer depth resolution.
+// The baselines and lenses on offer, checked and counted before anything is ranked.
+struct Hardware {
+    std::vector<double> lenses, baselines;
+};
+
+Hardware hardwareOf(const DesignArgs &args) {
+    Hardware h{numberList("--lenses", args.lenses), baselines(args.baselines)};
+    for (double v : h.lenses)
+        if (!(v > 0)) throw UsageError("--lenses: focal lengths must be positive mm");
+    for (double v : h.baselines)
+        if (!(v > 0)) throw UsageError("--baselines: baselines must be positive mm");
+    if (h.baselines.size() * h.lenses.size() > kMaxCandidates)
+        throw UsageError("--baselines x --lenses: " + std::to_string(h.baselines.size() * h.lenses.size()) +
+                         " configurations; at most " + std::to_string(kMaxCandidates));
+    return h;
+}
+
+std::vector<Candidate> rankCandidates(const DesignArgs &args, const Hardware &hw, const std::vector<double> &ranges,
+                                      const std::string &predictor) {
+    method::PanelPlacement panel;
+    panel.width_mm = args.panel_width_mm;
+    panel.height_mm = args.panel_height_mm;
     std::vector<Candidate> cands;
-    for (double b : bases)
-        for (double f : lenses) {
+    for (double b : hw.baselines)
+        for (double f : hw.lenses) {
             Candidate c{b, f, {}, INFINITY, true, true, NAN};
-            head.baseline_mm = b;
-            head.focal_length_mm = f;
+            const method::StereoDesign head = args.head.configured(b, f, args.head.camera_height_mm, args.head.inclination_deg);
             for (double r : ranges) {
-                c.at.push_back(method::designFigures(head, r, 0.25, &panel));
+                c.at.push_back(method::designFigures(head, r, method::kMatchingErrorPx, &panel));
                 const auto &x = c.at.back();
                 c.worst_score = std::min(c.worst_score, method::predictors(head, r, panel).get(predictor));
                 c.panel_fits = c.panel_fits && x.panel_fits_width;
@@ -129,9 +160,6 @@ int design(const DesignArgs &args) {
             }
             cands.push_back(c);
         }
-    // Rank: configurations that see the whole panel and whose search reaches the range
-    // first, then the predictor's score at the band's worst range, then the finer depth
-    // resolution.
     auto byFigures = [](const Candidate &a, const Candidate &b) {
         if (a.panel_fits != b.panel_fits) return a.panel_fits;
         if (a.in_search != b.in_search) return a.in_search;
@@ -139,41 +167,44 @@ int design(const DesignArgs &args) {
         return a.at.back().depth_resolution_mm < b.at.back().depth_resolution_mm;
     };
     std::stable_sort(cands.begin(), cands.end(), byFigures);
+    return cands;
+}
 
-    const size_t top = static_cast<size_t>(args.top);
-    if (args.simulate) {
-        // Measure η3D on the simulated rig for the best `--simulate-count` by figures.
-        const size_t n = std::min(cands.size(), static_cast<size_t>(args.simulate_count));
-        PluginHost host;
-        // No scan: the rig opens only the plugins it names.
-        const std::string rig = args.rig.empty() ? dataFile("configs/rigs/sim-e1.yaml") : args.rig;
-        std::vector<TestGeometry> tests;
-        std::vector<size_t> which;
-        for (size_t i = 0; i < n; ++i)
-            for (double r : ranges) {
-                tests.push_back({cands[i].baseline_mm, cands[i].focal_length_mm, r, head.camera_height_mm, head.inclination_deg});
-                which.push_back(i);
-            }
-        Experiment e = makeExperiment("design", rig, tests, host);
-        ExperimentOptions opt;
-        opt.out_dir = (args.out.empty() ? std::string("out/design") : args.out) + "/simulated";
-        opt.progress = !args.quiet;
-        const ExperimentResult result = runExperiment(e, host, opt);
-        // Averaged over the band: a configuration is as good as it is across it.
-        std::vector<double> sum(n, 0), cnt(n, 0);
-        for (size_t t = 0; t < result.rows.size() && t < which.size(); ++t) {
-            const double eta = result.rows[t].get("eta_3d_percent");
-            if (!std::isfinite(eta)) continue;
-            sum[which[t]] += eta;
-            cnt[which[t]] += 1;
+// --simulate: η3D measured on the simulated rig for the best `--simulate-count` by
+// figures, averaged over the band (a configuration is as good as it is across it).
+void simulate(const DesignArgs &args, const std::vector<double> &ranges, std::vector<Candidate> &cands) {
+    const size_t n = std::min(cands.size(), static_cast<size_t>(args.simulate_count));
+    PluginHost host;
+    // No scan: the rig opens only the plugins it names.
+    const std::string rig = args.rig.empty() ? dataFile("configs/rigs/sim-e1.yaml") : args.rig;
+    std::vector<TestGeometry> tests;
+    std::vector<size_t> which;
+    for (size_t i = 0; i < n; ++i)
+        for (double r : ranges) {
+            tests.push_back({cands[i].baseline_mm, cands[i].focal_length_mm, r, args.head.camera_height_mm, args.head.inclination_deg});
+            which.push_back(i);
         }
-        for (size_t i = 0; i < n; ++i) cands[i].eta_3d = cnt[i] ? sum[i] / cnt[i] : 0.0;
-        std::stable_sort(cands.begin(), cands.begin() + static_cast<long>(n),
-                         [](const Candidate &a, const Candidate &b) { return a.eta_3d > b.eta_3d; });
+    Experiment e = makeExperiment("design", rig, tests, host);
+    ExperimentOptions opt;
+    opt.out_dir = (args.out.empty() ? std::string("out/design") : args.out) + "/simulated";
+    opt.progress = !args.quiet;
+    const ExperimentResult result = runExperiment(e, host, opt);
+    std::vector<double> sum(n, 0), cnt(n, 0);
+    for (size_t t = 0; t < result.rows.size() && t < which.size(); ++t) {
+        const double eta = result.rows[t].get("eta_3d_percent");
+        if (!std::isfinite(eta)) continue;
+        sum[which[t]] += eta;
+        cnt[which[t]] += 1;
     }
+    for (size_t i = 0; i < n; ++i) cands[i].eta_3d = cnt[i] ? sum[i] / cnt[i] : 0.0;
+    std::stable_sort(cands.begin(), cands.begin() + static_cast<long>(n),
+                     [](const Candidate &a, const Candidate &b) { return a.eta_3d > b.eta_3d; });
+}
 
-    // Table on stdout, JSON and CSV in --out.
+// The table on stdout; design.json and design.csv in --out.
+void writeRanking(const DesignArgs &args, const std::vector<Candidate> &cands, const std::string &predictor) {
     const bool sim = args.simulate;
+    const size_t top = static_cast<size_t>(args.top);
     std::printf("%-4s %8s %7s %7s %9s %10s %9s %7s %s\n", "rank", "B (mm)", "f (mm)", "FF", "d (px)", "dR (mm)", "Rmin (m)",
                 "panel", sim ? "η3D (%)" : "reading");
     Json list = Json::array();
@@ -222,6 +253,15 @@ int design(const DesignArgs &args) {
         writeFileAtomic(args.out + "/design.csv", csv);
         spdlog::info("design: {} configurations ranked; design.json and design.csv in {}", cands.size(), args.out);
     }
+}
+
+int design(const DesignArgs &args) {
+    const std::vector<double> ranges = targetRanges(args);
+    const Hardware hw = hardwareOf(args);
+    const std::string predictor = choosePredictor(args);
+    std::vector<Candidate> cands = rankCandidates(args, hw, ranges, predictor);
+    if (args.simulate) simulate(args, ranges, cands);
+    writeRanking(args, cands, predictor);
     return 0;
 }
 
@@ -234,7 +274,7 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
               "ff_band (closeness to the paper's best band 1.2-2.0), expected_disparity,\n"
               "depth_resolution (-dR/R) or sensor_aware (η3D predicted from the design); the\n"
               "band's worst range counts. Beside FF it reports the expected disparity d = B·f/(R·p), the\n"
-              "depth resolution dR = R²·p·Δd/(B·f) for Δd = 0.25 px, the minimum range of the\n"
+              "depth resolution dR = R²·p·Δd/(B·f) for Δd = " + num(method::kMatchingErrorPx) + " px, the minimum range of the\n"
               "disparity search and whether the panel fits the stereo field.\n"
               "One of --range or --band is required.",
               [](CLI::App &app) -> Runner {
@@ -246,16 +286,21 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
                       ->type_name("MM,MM...");
                   app.add_option("--baselines", a->baselines, "baselines, mm: MIN:MAX:STEP or a list (default 100:200:10)")
                       ->type_name("SPEC");
-                  app.add_option("--pixel-pitch-um", a->pixel_pitch_um, "effective pixel pitch (default: the Videre head decimated by 4, 20.8)")
+                  app.add_option("--pixel-pitch-um", a->head.pixel_pitch_um, "effective pixel pitch (default: the Videre head decimated by 4, 20.8)")
                       ->type_name("UM")
                       ->check(positiveNumber());
-                  app.add_option("--image-width", a->image_width, "image width in pixels (default 320)")->type_name("PX")->check(atLeast(1));
-                  app.add_option("--image-height", a->image_height, "image height in pixels (default 240)")->type_name("PX")->check(atLeast(1));
-                  app.add_option("--num-disparities", a->num_disparities, "the matcher's disparity search (default 64)")
+                  app.add_option("--image-width", a->head.image_width_px, "image width in pixels (default 320)")->type_name("PX")->check(atLeast(1));
+                  app.add_option("--image-height", a->head.image_height_px, "image height in pixels (default 240)")->type_name("PX")->check(atLeast(1));
+                  app.add_option("--num-disparities", a->head.num_disparities, "the matcher's disparity search (default 64)")
                       ->type_name("N")
                       ->check(atLeast(1));
-                  app.add_option("--camera-height-mm", a->camera_height_mm, "camera height (default 1500)")->type_name("MM");
-                  app.add_option("--inclination-deg", a->inclination_deg, "inclination (default 0)")->type_name("DEG")->check(CLI::Range(-89.0, 89.0));
+                  app.add_option("--camera-height-mm", a->head.camera_height_mm, "camera height (default " + num(method::kDefaultCameraHeightMm) + ")")
+                      ->type_name("MM")
+                      ->check(decimalNumber());
+                  app.add_option("--inclination-deg", a->head.inclination_deg, "inclination (default 0)")
+                      ->type_name("DEG")
+                      ->check(decimalNumber())
+                      ->check(CLI::Range(-89.0, 89.0));
                   app.add_option("--panel-width-mm", a->panel_width_mm, "width of the object that must fit (default 2500)")
                       ->type_name("MM")
                       ->check(positiveNumber());

@@ -17,23 +17,23 @@ namespace {
 struct ExperimentArgs {
     std::string file, out, shard;
     std::vector<std::string> tests, set;
-    bool check = false, quiet = false, report = false;
+    bool check = false, quiet = false, report = false, force = false;
     std::vector<std::string> merge; // `experiment merge OUT DIR...`
 };
 
-int merge(const std::vector<std::string> &p) {
+int merge(const std::vector<std::string> &p, bool force) {
     if (p.size() < 2) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
     PluginHost host;
     host.scan();
-    const OutputFolder folder(p[0], OutputClaim{OutputKind::Experiment, false, "binocle experiment merge"});
-    const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host);
+    const OutputFolder folder(p[0], OutputClaim{OutputKind::Experiment, force, "binocle experiment merge"});
+    const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host, force);
     spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.rows.size(), p.size() - 1,
                  result.failed, p[0]);
     return result.failed ? 1 : 0;
 }
 
 int experiment(const ExperimentArgs &args) {
-    if (!args.merge.empty()) return merge(args.merge);
+    if (!args.merge.empty()) return merge(args.merge, args.force);
     if (args.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
@@ -46,10 +46,11 @@ int experiment(const ExperimentArgs &args) {
     ExperimentOptions options;
     options.out_dir = args.out.empty() ? "out/" + e.name : args.out;
     options.progress = !args.quiet;
+    options.replace = args.force;
     if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
     for (const auto &id : args.tests)
         if (!id.empty()) options.only.push_back(id);
-    const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, false, "binocle experiment"});
+    const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, args.force, "binocle experiment"});
     const ExperimentResult result = runExperiment(e, host, options);
     spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",
                  e.name, result.rows.size(), static_cast<int>(result.seconds), result.failed, options.out_dir);
@@ -84,7 +85,8 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
                   app.add_option("--shard", args->shard,
                                  "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
                                  "shards with `binocle experiment merge OUT DIR...`")
-                      ->type_name("K/N");
+                      ->type_name("K/N")
+                      ->check(wholeNumbers('/', 1));
                   auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
                                                         "one unsharded run (timings apart)");
                   m->add_option("folders", args->merge, "OUT DIR...")->required()->expected(2, -1);
@@ -94,6 +96,8 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
                       ->delimiter(',')
                       ->allow_extra_args(false);
                   app.add_flag("--check", args->check, "validate the file and stop");
+                  app.add_flag("--force", args->force, "replace the results of another experiment in the output folder");
+                  m->add_flag("--force", args->force, "replace the results already in OUT");
                   app.add_flag("--quiet", args->quiet, "no progress display");
                   app.add_flag("--report", args->report, "also write DIR/report.html (as `binocle report DIR`)");
                   return [args] { return experiment(*args); };

@@ -24,6 +24,8 @@ struct RecordArgs {
     int writer_threads = 0; // 0: the writer's default
     std::string when_behind; // empty: from the source (drop when live)
     bool statistics = false, quiet = false;
+    std::string format = "folder";
+    RosbagOptions rosbag;
 };
 
 int record(const RecordArgs &args) {
@@ -42,6 +44,9 @@ int record(const RecordArgs &args) {
     options.writer.png_compression = args.png_compression;
     options.writer.threads = args.writer_threads;
     if (!args.when_behind.empty()) options.drop_when_behind = args.when_behind == "drop";
+    options.format = args.format;
+    options.rosbag = args.rosbag;
+    checkRosbagOptions(options.rosbag);
     // One recorder per folder; the writer itself refuses a folder that holds anything.
     OutputFolder folder(args.out, OutputClaim{OutputKind::None, false, "binocle record"});
     RecordResult r = recordRig(rig, args.out, options);
@@ -80,6 +85,10 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
               "a recording cut short (process killed, power lost) plays back up to its last\n"
               "row. summary.json gives the pairs taken, written and lost, and where. Replay it with\n"
               "  source: {plugin: replay, folder: DIR}\n"
+              "--format mcap writes a ROS 2 bag instead (docs/ros2.md): DIR/<DIR>_0.mcap (rosbag2\n"
+              "MCAP: sensor_msgs/Image and CameraInfo per side under --ros-namespace, zstd chunks,\n"
+              "each fsync'ed; summary and footer on a clean stop) and DIR/metadata.yaml, for\n"
+              "ros2 bag play, Foxglove, and replay (source: {plugin: replay, bag: DIR}).\n"
               "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<RecordArgs>();
@@ -97,6 +106,7 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
                   app.add_option("--png-compression", args->png_compression,
                                  "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
                       ->type_name("L")
+                      ->check(wholeNumber())
                       ->check(CLI::Range(0, 9));
                   app.add_option("--writer-threads", args->writer_threads,
                                  "threads that encode and write images (default: two per core, 4..16)")
@@ -107,6 +117,19 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
                                  "(default: drop for a live source such as cameras, wait for files and simulations)")
                       ->type_name("wait|drop")
                       ->check(CLI::IsMember({"wait", "drop"}));
+                  app.add_option("--format", args->format,
+                                 "folder (PNG + frames.csv, the default) or mcap (a rosbag2 bag: docs/ros2.md)")
+                      ->type_name("folder|mcap")
+                      ->check(CLI::IsMember({"folder", "mcap"}));
+                  app.add_option("--ros-namespace", args->rosbag.ros_namespace,
+                                 "mcap: the topics' namespace (default /binocle: /binocle/left/image_raw ...)")
+                      ->type_name("NS");
+                  app.add_option("--frame-id-left", args->rosbag.frame_id_left,
+                                 "mcap: header.frame_id of the left images (default binocle_left_optical)")
+                      ->type_name("ID");
+                  app.add_option("--frame-id-right", args->rosbag.frame_id_right,
+                                 "mcap: header.frame_id of the right images (default binocle_right_optical)")
+                      ->type_name("ID");
                   app.add_flag("--statistics", args->statistics, "print the source's statistics (YAML) at the end");
                   app.add_flag("--quiet", args->quiet, "no progress display");
                   return [args] { return record(*args); };

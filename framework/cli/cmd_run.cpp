@@ -6,6 +6,10 @@
 #include "core/output_folder.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/stop_signal.hpp"
+#include "rosbag/rosbag_run_output.hpp"
+
+#include <filesystem>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -20,6 +24,8 @@ struct RunArgs {
     int64_t frames = -1;
     std::string out;
     bool quiet = false, force = false;
+    bool mcap = false;
+    RosbagOptions rosbag;
 };
 
 int runRig(const RunArgs &args) {
@@ -37,7 +43,14 @@ int runRig(const RunArgs &args) {
     if (!args.out.empty()) folder.emplace(args.out, OutputClaim{OutputKind::Run, args.force, "binocle run"});
     StopSignalGuard signals; // Ctrl-C / SIGTERM: finish the frames in flight, write the summary
     options.stop = &StopSignalGuard::requested();
-    Json summary = pipeline.run(options);
+    // --mcap: the frames also go into DIR/bag, a rosbag2 bag (docs/ros2.md).
+    std::optional<RosbagRunOutput> bag;
+    if (args.mcap && options.out_dir.empty()) throw UsageError("--mcap: expected --out DIR (the bag goes into DIR/bag)");
+    if (args.mcap) bag.emplace((std::filesystem::path(options.out_dir) / "bag").string(), args.rosbag);
+    Json summary = pipeline.run(options, [&](const FrameResult &r) {
+        if (bag) bag->onFrame(r, pipeline.calibration());
+    });
+    if (bag) bag->close();
     const bool interrupted = summary.value("status", "") == "interrupted";
     spdlog::info("binocle run: {} frame(s) of rig '{}'{}{}", summary.value("frame_count", int64_t{0}), rig.name,
                  interrupted ? " (interrupted)" : "",
@@ -53,6 +66,8 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "  disparity_NNNNNN.png        16-bit disparity, KITTI convention (d * 256, 0 = invalid)\n"
               "  disparity_color_NNNNNN.png  colourised disparity (invalid = black)\n"
               "  cloud_NNNNNN.ply            binary PLY, millimetres, frame stated in the header\n"
+              "  bag/                        with --mcap: a rosbag2 MCAP bag of the rectified\n"
+              "                              images, DisparityImage, PointCloud2 and figures (docs/ros2.md)\n"
               "and frames.jsonl (one line of figures per frame, written as it finishes) and\n"
               "summary.json (evaluator metrics, drops, status). Without --out the summary goes\n"
               "to standard output. One process writes into DIR at a time; a DIR that holds a\n"
@@ -71,6 +86,11 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
                   app.add_flag("--force", args->force,
                                "replace what --out holds when it is another kind of output (a recording, an experiment)");
                   app.add_flag("--quiet", args->quiet, "no progress display");
+                  app.add_flag("--mcap", args->mcap,
+                               "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
+                               "in the ground frame, figures (docs/ros2.md)");
+                  app.add_option("--ros-namespace", args->rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
+                      ->type_name("NS");
                   return [args] { return runRig(*args); };
               }}};
 

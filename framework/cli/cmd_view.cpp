@@ -44,18 +44,28 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
               "figure per frame. Its controls come from the plugins' settings tables; a change is\n"
               "validated like --set and applied between frames. Pause, step and snapshot (the\n"
               "frame's outputs, as `binocle run` writes them, into --out).\n"
-              "The URL printed at start carries a token that the page's controls need. Only\n"
-              "requests naming this machine (localhost, 127.0.0.1, ::1) are served. Browsers that\n"
-              "are slow get fewer frames; the pipeline never waits for them. Ctrl-C stops.\n"
+              "The URL printed at start carries a token that the page's controls need. It serves\n"
+              "127.0.0.1 only unless --bind names another address and --allow-remote is given;\n"
+              "requests must name the address they arrive on (or localhost on loopback, or an\n"
+              "--allow-host name). The page changes plugin settings only, not resource limits;\n"
+              "paths it sets stay inside the rig's folders (docs/security.md). Browsers that are\n"
+              "slow get fewer frames; the pipeline never waits for them. Ctrl-C stops.\n"
               "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<ViewArgs>();
                   addRigArgs(app, args->rig);
                   app.add_option("--port", args->options.port, "TCP port (0: any free port)")
                       ->type_name("N")
-                      ->check(CLI::Range(0, 65535))
+                      ->check(wholeNumberIn(0, 65535))
                       ->capture_default_str();
-                  app.add_option("--bind", args->options.address, "address to listen on")->type_name("ADDR")->capture_default_str();
+                  app.add_option("--bind", args->options.address, "address to listen on (an IP address)")
+                      ->type_name("ADDR")
+                      ->capture_default_str();
+                  app.add_flag("--allow-remote", args->options.allow_remote,
+                               "serve a --bind address other than loopback (the token then crosses the network in clear)");
+                  app.add_option("--allow-host", args->options.allowed_hosts,
+                                 "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
+                      ->type_name("NAME");
                   app.add_option("--out", args->options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
                   app.add_option("--display-fps", args->options.display_fps,
                                  "most frames per second sent to browsers (each gets no more than it can draw)")

@@ -60,9 +60,17 @@ void addRigArgs(CLI::App &app, RigArgs &args, bool required = true);
 // The rig with every --set override applied, validated against the plugins `host` found.
 RigConfig loadRig(const RigArgs &args, const PluginHost &host);
 
-// Validators with messages in the words of the other errors.
+// Validators with messages in the words of the other errors. Every numeric option takes
+// one of these, before any other check: they read the text with the one number reader
+// (input/numbers.hpp: decimal only), so that `--frames 010` is an error, as in a rig
+// file, and not 8 (CLI11 alone detects a base: "010" -> 8, "0x10" -> 16).
 CLI::Validator atLeast(long long min);   // a whole number >= min
+CLI::Validator wholeNumber();            // any whole number (then e.g. CLI::Range)
+CLI::Validator wholeNumberIn(long long min, long long max); // a whole number min..max
 CLI::Validator positiveNumber();         // a finite real > 0
+CLI::Validator decimalNumber();          // any finite real (then e.g. CLI::Range)
+// Whole numbers >= min joined by `separator`, e.g. "2/8" for --shard.
+CLI::Validator wholeNumbers(char separator, long long min);
 
 // A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
 // next to the executable, else from the source tree it was built from.

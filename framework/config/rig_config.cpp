@@ -7,7 +7,10 @@
 #include "input/text.hpp"
 #include "input/yaml_file.hpp"
 
+#include <binocle/settings.hpp>
+
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -26,7 +29,7 @@ std::string Location::str() const {
 Override Override::parse(const std::string &text) {
     const auto eq = text.find('=');
     if (eq == std::string::npos || eq == 0)
-        throw Error("--set " + text + ": expected KEY=VALUE, e.g. --set matcher.num_disparities=128");
+        throw OverrideError("--set " + text + ": expected KEY=VALUE, e.g. --set matcher.num_disparities=128");
     Override o;
     o.path = text.substr(0, eq);
     o.value = text.substr(eq + 1);
@@ -76,7 +79,12 @@ struct Context {
         return loc;
     }
     [[noreturn]] void fail(const YAML::Node &node, const std::string &path, const std::string &what) const {
-        throw Error(at(node, path).str() + ": " + path + ": " + what);
+        raise(at(node, path), path + ": " + what);
+    }
+    // A value from --set is a mistake on the command line; from the file, in the file.
+    [[noreturn]] void raise(const Location &loc, const std::string &message) const {
+        if (!loc.override.empty()) throw OverrideError(loc.str() + ": " + message);
+        throw Error(loc.str() + ": " + message);
     }
 };
 
@@ -94,103 +102,49 @@ std::string flowText(const YAML::Node &n) {
     return e.c_str();
 }
 
-// A map key as text; a non-scalar key (YAML allows "? [a, b]") is named, not converted.
-
-std::string describeChoices(const binocle_param_desc &d) {
-    std::string c = d.choices ? d.choices : "";
-    std::replace(c.begin(), c.end(), '|', ',');
-    return c;
-}
-
-std::string fmtNumber(double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
+// One scalar through the SDK's settings checker (binocle/settings.hpp), the one home of
+// what a setting accepts: plugin settings, `runtime:`, `outputs:`, isolation keys and
+// --set values all read here, so the same text gets the same answer everywhere.
+sdk::SettingValue readScalar(const binocle_param_desc &d, const YAML::Node &n, const Context &ctx,
+                             const std::string &path) {
+    sdk::SettingValue v;
+    const sdk::SettingProblem why =
+        n.IsScalar() ? sdk::readSetting(d, n.Scalar(), v) : sdk::SettingProblem{"is not a scalar", sdk::settingExpects(d)};
+    if (why) {
+        const std::string hint =
+            d.type == BINOCLE_PARAM_ENUM && n.IsScalar() ? input::nearestWord(n.Scalar(), sdk::settingChoices(d)) : "";
+        ctx.fail(n, path, "value '" + scalarText(n) + "' is not valid: expected " + why.expected +
+                              (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+    }
+    return v;
 }
 
 // Parses and checks one value against its description; stores it in `out`.
 void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n, bool isExplicit, const Context &ctx,
               const std::string &path) {
-    const std::string text = scalarText(n);
     auto bad = [&](const std::string &expected) {
-        ctx.fail(n, path, "value '" + text + "' is not valid: expected " + expected);
-    };
-    auto checkRange = [&](double v, const char *kind) {
-        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) bad(std::string(kind) + " >= " + fmtNumber(d.min));
-        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) bad(std::string(kind) + " <= " + fmtNumber(d.max));
+        ctx.fail(n, path, "value '" + scalarText(n) + "' is not valid: expected " + expected);
     };
     switch (d.type) {
-    case BINOCLE_PARAM_BOOL: {
-        bool v = false;
-        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) bad("true or false");
-        out.setBool(d.name, v, isExplicit);
-        break;
-    }
-    case BINOCLE_PARAM_INT: {
-        long long v = 0;
-        std::string what = "an integer";
-        if (d.multiple_of > 0) what = "an integer multiple of " + std::to_string(d.multiple_of);
-        if (d.flags & BINOCLE_PARAM_FLAG_ODD) what = "an odd integer";
-        if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) what += " >= " + fmtNumber(d.min);
-        if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) what += " <= " + fmtNumber(d.max);
-        // One strict reader for the file and --set alike: decimal only ("0640" is not 416),
-        // range-checked before any narrowing.
-        std::string why;
-        int64_t parsed = 0;
-        if (!n.IsScalar() || !input::parseInteger(n.Scalar(), parsed, &why))
-            bad(why.find("leading zeros") != std::string::npos || why.find("64 bits") != std::string::npos
-                    ? what + " (" + why + ")"
-                    : what);
-        v = parsed;
-        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) bad(what);
-        if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) bad(what);
-        if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) bad(what);
-        if (d.multiple_of > 0 && v % d.multiple_of != 0) bad(what);
-        out.setInt(d.name, v, isExplicit);
-        break;
-    }
-    case BINOCLE_PARAM_DOUBLE: {
-        double v = 0;
-        if (!n.IsScalar() || !input::parseReal(n.Scalar(), v)) bad("a decimal number");
-        if (!std::isfinite(v)) bad("a finite number");
-        checkRange(v, "a number");
-        out.setDouble(d.name, v, isExplicit);
-        break;
-    }
-    case BINOCLE_PARAM_ENUM: {
-        std::string choices = d.choices ? d.choices : "";
-        std::vector<std::string> list;
-        std::stringstream ss(choices);
-        for (std::string c; std::getline(ss, c, '|');) list.push_back(c);
-        if (!n.IsScalar() || std::find(list.begin(), list.end(), n.Scalar()) == list.end()) {
-            std::string hint = n.IsScalar() ? input::nearestWord(n.Scalar(), list) : "";
-            bad("one of " + describeChoices(d) + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
-        }
-        out.setText(d.name, d.type, n.Scalar(), isExplicit);
-        break;
-    }
-    case BINOCLE_PARAM_STRING:
-        if (!n.IsScalar()) bad("a string");
-        out.setText(d.name, d.type, n.Scalar(), isExplicit);
-        break;
+    case BINOCLE_PARAM_BOOL: out.setBool(d.name, readScalar(d, n, ctx, path).boolean, isExplicit); break;
+    case BINOCLE_PARAM_INT: out.setInt(d.name, readScalar(d, n, ctx, path).integer, isExplicit); break;
+    case BINOCLE_PARAM_DOUBLE: out.setDouble(d.name, readScalar(d, n, ctx, path).real, isExplicit); break;
+    case BINOCLE_PARAM_ENUM:
+    case BINOCLE_PARAM_STRING: out.setText(d.name, d.type, readScalar(d, n, ctx, path).text, isExplicit); break;
     case BINOCLE_PARAM_PATH: {
-        if (!n.IsScalar()) bad("a path");
-        std::string p = n.Scalar();
+        std::string p = readScalar(d, n, ctx, path).text;
         if (!p.empty() && fs::path(p).is_relative() && !ctx.base_dir.empty()) p = (fs::path(ctx.base_dir) / p).lexically_normal().string();
         out.setText(d.name, d.type, p, isExplicit);
         break;
     }
     case BINOCLE_PARAM_INT_LIST:
     case BINOCLE_PARAM_DOUBLE_LIST: {
-        const bool ints = d.type == BINOCLE_PARAM_INT_LIST;
-        const char *what = ints ? "a list of integers, e.g. [1, 2]" : "a list of numbers, e.g. [0.1, 0.2]";
-        if (!n.IsSequence()) bad(what);
-        for (const auto &e : n) {
-            int64_t i = 0;
-            double x = 0;
-            if (!e.IsScalar() || (ints ? !input::parseInteger(e.Scalar(), i) : !input::parseReal(e.Scalar(), x)))
-                bad(what);
-        }
+        // Each element by the same reader, checked as the flow text the plugin receives.
+        if (!n.IsSequence()) bad(sdk::settingExpects(d));
+        for (const auto &e : n)
+            if (!e.IsScalar()) bad(sdk::settingExpects(d));
+        sdk::SettingValue v;
+        if (const sdk::SettingProblem why = sdk::readSetting(d, flowText(n), v)) bad(why.expected);
         out.setText(d.name, d.type, flowText(n), isExplicit);
         break;
     }
@@ -207,29 +161,26 @@ void setValue(ParamValues &out, const binocle_param_desc &d, const YAML::Node &n
 // Keys of every plugin block besides the plugin's own settings.
 const std::vector<std::string> kBlockKeys = {"plugin", "isolation", "call_timeout_ms", "restart", "max_restarts"};
 
+// The keys of a block besides the plugin's settings, described as settings are.
+const binocle_param_desc kIsolationKeys[] = {
+    sdk::Param::choice("isolation", "none", "process|none"),
+    sdk::Param::integer("call_timeout_ms", "0").min(0).max(3600000),
+    sdk::Param::boolean("restart", false),
+    sdk::Param::integer("max_restarts", "3").min(0).max(3600000),
+};
+
 // `isolation: process|none`, `call_timeout_ms`, `restart`, `max_restarts` of a block.
 IsolationOptions isolationOf(const YAML::Node &node, const std::string &where, const Context &ctx) {
     IsolationOptions o;
-    if (YAML::Node n = node["isolation"]) {
-        if (!n.IsScalar() || (n.Scalar() != "process" && n.Scalar() != "none"))
-            ctx.fail(n, where + ".isolation", "value '" + scalarText(n) + "' is not valid: expected process or none");
-        o.process = n.Scalar() == "process";
-    }
-    auto integer = [&](const char *key, int32_t &v, int32_t least) {
-        YAML::Node n = node[key];
-        if (!n) return;
-        long long x = 0;
-        if (!n.IsScalar() || !YAML::convert<long long>::decode(n, x) || x < least || x > 3600000)
-            ctx.fail(n, where + "." + key, "value '" + scalarText(n) + "' is not valid: expected an integer >= " +
-                                               std::to_string(least));
-        v = static_cast<int32_t>(x);
+    auto read = [&](const binocle_param_desc &d) -> std::optional<sdk::SettingValue> {
+        YAML::Node n = node[d.name];
+        if (!n) return std::nullopt;
+        return readScalar(d, n, ctx, where + "." + d.name);
     };
-    integer("call_timeout_ms", o.call_timeout_ms, 0);
-    integer("max_restarts", o.max_restarts, 0);
-    if (YAML::Node n = node["restart"]) {
-        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, o.restart))
-            ctx.fail(n, where + ".restart", "value '" + scalarText(n) + "' is not valid: expected true or false");
-    }
+    if (auto v = read(kIsolationKeys[0])) o.process = v->text == "process";
+    if (auto v = read(kIsolationKeys[1])) o.call_timeout_ms = static_cast<int32_t>(v->integer);
+    if (auto v = read(kIsolationKeys[2])) o.restart = v->boolean;
+    if (auto v = read(kIsolationKeys[3])) o.max_restarts = static_cast<int32_t>(v->integer);
     if (!o.process && (node["call_timeout_ms"] || node["restart"] || node["max_restarts"]))
         ctx.fail(node, where, "call_timeout_ms, restart and max_restarts need isolation: process");
     return o;
@@ -248,7 +199,7 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
             if (!kv.first.IsScalar() || std::find(kBlockKeys.begin(), kBlockKeys.end(), kv.first.Scalar()) == kBlockKeys.end())
                 settingsOnly.force_insert(kv.first, kv.second);
         if (auto unknown = input::findUnknownKey(settingsOnly, names, "for plugin '" + record.name + "'"))
-            throw Error(ctx.at(unknown->key, where + "." + unknown->name).str() + ": " + where + ": " + unknown->message);
+            ctx.raise(ctx.at(unknown->key, where + "." + unknown->name), where + ": " + unknown->message);
     }
     ParamValues values;
     for (const auto &d : descs) {
@@ -276,59 +227,53 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
 
 const std::vector<std::string> kTopKeys = {"name", "description", "source", "calibration", "matcher",
                                            "transforms", "evaluators", "outputs", "runtime"};
-const std::vector<std::string> kOutputKeys = {"disparity_png", "disparity_color", "disparity_pfm", "cloud_ply",
-                                              "rectified_png", "max_range_mm"};
+// `outputs:`, described as settings are; the order is the one build() reads them in.
+const binocle_param_desc kOutputKeys[] = {
+    sdk::Param::boolean("disparity_png", true), sdk::Param::boolean("disparity_color", true),
+    sdk::Param::boolean("disparity_pfm", false), sdk::Param::boolean("cloud_ply", true),
+    sdk::Param::boolean("rectified_png", false), sdk::Param::real("max_range_mm", "50000"),
+};
 
-const std::vector<std::string> kRuntimeKeys = {"policy", "queue_depth", "matcher_instances", "on_source_error",
-                                               "retry_for_s"};
+// The `runtime:` block, described as settings are (README "Runtime"); policy has no
+// default: unset, the source decides.
+const binocle_param_desc kRuntimeKeys[] = {
+    sdk::Param::choice("policy", "lossless", "lossless|latest"),
+    sdk::Param::integer("queue_depth", "4").min(1).max(1024),
+    sdk::Param::integer("matcher_instances", "1").min(1).max(64),
+    sdk::Param::choice("on_source_error", "stop", "stop|retry"),
+    sdk::Param::real("retry_for_s", "30"), // > 0: checked after, in words of seconds
+};
+
+std::vector<std::string> namesOf(const binocle_param_desc *table, size_t count) {
+    std::vector<std::string> names;
+    for (size_t i = 0; i < count; ++i) names.emplace_back(table[i].name);
+    return names;
+}
 
 RuntimeOptions runtimeBlock(const YAML::Node &r, const Context &ctx) {
     RuntimeOptions rt;
     if (!r.IsDefined() || r.IsNull()) return rt;
     if (!r.IsMap()) ctx.fail(r, "runtime", "expected a map (policy: lossless, queue_depth: 4, ...)");
-    if (auto unknown = input::findUnknownKey(r, kRuntimeKeys))
-        throw Error(ctx.at(unknown->key, "runtime." + unknown->name).str() + ": runtime: " + unknown->message);
-    auto choice = [&](const char *key, const std::vector<std::string> &choices) -> std::optional<std::string> {
-        YAML::Node n = r[key];
+    if (auto unknown = input::findUnknownKey(r, namesOf(kRuntimeKeys, std::size(kRuntimeKeys))))
+        ctx.raise(ctx.at(unknown->key, "runtime." + unknown->name), "runtime: " + unknown->message);
+    auto read = [&](const binocle_param_desc &d) -> std::optional<sdk::SettingValue> {
+        YAML::Node n = r[d.name];
         if (!n || n.IsNull()) return std::nullopt;
-        if (n.IsScalar() && std::find(choices.begin(), choices.end(), n.Scalar()) != choices.end()) return n.Scalar();
-        std::string all, hint = n.IsScalar() ? input::nearestWord(n.Scalar(), choices) : "";
-        for (const auto &c : choices) all += (all.empty() ? "" : ", ") + c;
-        ctx.fail(n, std::string("runtime.") + key, "value '" + scalarText(n) + "' is not valid: expected one of " + all +
-                                                      (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+        return readScalar(d, n, ctx, std::string("runtime.") + d.name);
     };
-    auto integer = [&](const char *key, int &out, int lo, int hi) {
-        YAML::Node n = r[key];
-        if (!n || n.IsNull()) return;
-        long long v = 0;
-        bool ok = n.IsScalar();
-        if (ok) {
-            try {
-                size_t used = 0;
-                v = std::stoll(n.Scalar(), &used, 10);
-                ok = used == n.Scalar().size();
-            } catch (const std::logic_error &) {
-                ok = false;
-            }
-        }
-        if (!ok || v < lo || v > hi)
-            ctx.fail(n, std::string("runtime.") + key, "value '" + scalarText(n) + "' is not valid: expected an integer >= " +
-                                                          std::to_string(lo) + " <= " + std::to_string(hi));
-        out = static_cast<int>(v);
-    };
-    if (auto p = choice("policy", {"lossless", "latest"}))
-        rt.policy = *p == "latest" ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
-    integer("queue_depth", rt.queue_depth, 1, 1024);
-    integer("matcher_instances", rt.matcher_instances, 1, 64);
-    if (auto e = choice("on_source_error", {"stop", "retry"}))
-        rt.on_source_error = *e == "retry" ? RuntimeOptions::OnSourceError::Retry : RuntimeOptions::OnSourceError::Stop;
-    if (YAML::Node n = r["retry_for_s"]; n && !n.IsNull()) {
-        double v = 0;
-        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v) || !(v > 0))
+    if (auto p = read(kRuntimeKeys[0]))
+        rt.policy = p->text == "latest" ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
+    if (auto v = read(kRuntimeKeys[1])) rt.queue_depth = static_cast<int>(v->integer);
+    if (auto v = read(kRuntimeKeys[2])) rt.matcher_instances = static_cast<int>(v->integer);
+    if (auto e = read(kRuntimeKeys[3]))
+        rt.on_source_error = e->text == "retry" ? RuntimeOptions::OnSourceError::Retry : RuntimeOptions::OnSourceError::Stop;
+    if (auto v = read(kRuntimeKeys[4])) {
+        const YAML::Node n = r["retry_for_s"];
+        if (!(v->real > 0))
             ctx.fail(n, "runtime.retry_for_s", "value '" + scalarText(n) + "' is not valid: expected a positive number of seconds");
         if (rt.on_source_error != RuntimeOptions::OnSourceError::Retry)
             ctx.fail(n, "runtime.retry_for_s", "is only used with on_source_error: retry (on_source_error is stop)");
-        rt.retry_for_s = v;
+        rt.retry_for_s = v->real;
     }
     return rt;
 }
@@ -380,7 +325,7 @@ std::vector<PluginBlock> blockList(const YAML::Node &node, const std::string &wh
 RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &host) {
     if (!root.IsMap()) throw Error(ctx.file + ": expected a YAML map with source, matcher, ... at the top level");
     if (auto unknown = input::findUnknownKey(root, kTopKeys))
-        throw Error(ctx.at(unknown->key, unknown->name).str() + ": " + unknown->message);
+        ctx.raise(ctx.at(unknown->key, unknown->name), unknown->message);
     RigConfig rig;
     rig.file = ctx.file;
     rig.base_dir = ctx.base_dir;
@@ -403,24 +348,22 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     }
     if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
         if (!o.IsMap()) ctx.fail(o, "outputs", "expected a map (disparity_png: true, ...)");
-        if (auto unknown = input::findUnknownKey(o, kOutputKeys))
-            throw Error(ctx.at(unknown->key, "outputs." + unknown->name).str() + ": outputs: " + unknown->message);
-        auto flag = [&](const char *key, bool &v) {
-            YAML::Node n = o[key];
-            if (!n) return;
-            if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
-                ctx.fail(n, std::string("outputs.") + key, "value '" + scalarText(n) + "' is not valid: expected true or false");
+        if (auto unknown = input::findUnknownKey(o, namesOf(kOutputKeys, std::size(kOutputKeys))))
+            ctx.raise(ctx.at(unknown->key, "outputs." + unknown->name), "outputs: " + unknown->message);
+        auto read = [&](const binocle_param_desc &d) -> std::optional<sdk::SettingValue> {
+            YAML::Node n = o[d.name];
+            if (!n) return std::nullopt;
+            return readScalar(d, n, ctx, std::string("outputs.") + d.name);
         };
-        flag("disparity_png", rig.outputs.disparity_png);
-        flag("disparity_color", rig.outputs.disparity_color);
-        flag("disparity_pfm", rig.outputs.disparity_pfm);
-        flag("cloud_ply", rig.outputs.cloud_ply);
-        flag("rectified_png", rig.outputs.rectified_png);
-        if (YAML::Node n = o["max_range_mm"]) {
-            double v = 0;
-            if (!n.IsScalar() || !input::parseReal(n.Scalar(), v) || !(v > 0))
-                ctx.fail(n, "outputs.max_range_mm", "value '" + scalarText(n) + "' is not valid: expected a positive number of mm");
-            rig.outputs.max_range_mm = v;
+        bool *flags[] = {&rig.outputs.disparity_png, &rig.outputs.disparity_color, &rig.outputs.disparity_pfm,
+                         &rig.outputs.cloud_ply, &rig.outputs.rectified_png};
+        for (size_t i = 0; i < std::size(flags); ++i)
+            if (auto v = read(kOutputKeys[i])) *flags[i] = v->boolean;
+        if (auto v = read(kOutputKeys[5])) {
+            if (!(v->real > 0))
+                ctx.fail(o["max_range_mm"], "outputs.max_range_mm",
+                         "value '" + scalarText(o["max_range_mm"]) + "' is not valid: expected a positive number of mm");
+            rig.outputs.max_range_mm = v->real;
         }
     }
     rig.runtime = runtimeBlock(root["runtime"], ctx);
@@ -441,19 +384,19 @@ RigConfig rigFromTree(YAML::Node root, const std::string &file, const std::vecto
 
 void applyOverride(YAML::Node &root, const Override &o) {
     const auto parts = splitPath(o.path);
-    if (parts.empty()) throw Error("--set " + o.text + ": empty key");
+    if (parts.empty()) throw OverrideError("--set " + o.text + ": empty key");
     YAML::Node value;
     try {
         value = input::parseYaml(o.value, "--set " + o.text);
     } catch (const input::YamlError &e) {
-        throw Error(e.what());
+        throw OverrideError(e.what());
     }
     // A list index: decimal, within the list; checked before any conversion.
     auto index = [&](const YAML::Node &list, const std::string &part) -> size_t {
         int64_t i = 0;
         const int64_t last = static_cast<int64_t>(list.size()) - 1;
         if (!input::parseInteger(part, i, nullptr, 0, last))
-            throw Error("--set " + o.text + ": '" + input::printable(part) + "' is not an index of the list (" +
+            throw OverrideError("--set " + o.text + ": '" + input::printable(part) + "' is not an index of the list (" +
                         (last < 0 ? std::string("the list is empty") : "0.." + std::to_string(last)) + ")");
         return static_cast<size_t>(i);
     };
@@ -471,7 +414,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
                 next = cur[parts[i]];
             }
         } else {
-            throw Error("--set " + o.text + ": '" + parts[i] + "' leads into a scalar value");
+            throw OverrideError("--set " + o.text + ": '" + parts[i] + "' leads into a scalar value");
         }
         chain.push_back(next);
     }
@@ -479,7 +422,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
     if (last.IsSequence()) {
         last[index(last, parts.back())] = value;
     } else if (last.IsScalar()) {
-        throw Error("--set " + o.text + ": the parent of '" + parts.back() + "' is a scalar value");
+        throw OverrideError("--set " + o.text + ": the parent of '" + parts.back() + "' is a scalar value");
     } else {
         last[parts.back()] = value;
     }

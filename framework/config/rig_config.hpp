@@ -5,6 +5,7 @@
 // expected.
 #pragma once
 
+#include "core/error.hpp"
 #include "host/plugin_host.hpp"
 
 #include <optional>
@@ -66,13 +67,20 @@ struct RigConfig {
     std::string resolved_yaml; // the rig after --set overrides
 };
 
+// A mistake in a value that came from the command line (--set): the command reports it
+// as wrong usage (exit status 2), with the same words as the same value in the file.
+class OverrideError : public Error {
+public:
+    using Error::Error;
+};
+
 // "key=value" with a dotted key path ("matcher.num_disparities=128",
 // "transforms.0.inclination_deg=10"); the value is parsed as YAML.
 struct Override {
     std::string path;
     std::string value;
     std::string text;
-    static Override parse(const std::string &text); // throws Error on a malformed text
+    static Override parse(const std::string &text); // throws OverrideError on a malformed text
 };
 
 // Loads, applies overrides, validates against the plugins `host` found.
@@ -83,7 +91,8 @@ RigConfig loadRigText(const std::string &text, const std::string &file, const st
 // Same from a YAML tree already loaded (experiments build rigs this way).
 RigConfig rigFromNode(const YAML::Node &root, const std::string &file, const PluginHost &host);
 
-// Applies one override to a tree; creates missing maps; throws on a path through a scalar.
+// Applies one override to a tree; creates missing maps; throws OverrideError on a path
+// through a scalar.
 void applyOverride(YAML::Node &root, const Override &o);
 
 // Validates a plugin block against the plugin's table and returns the values it gets.

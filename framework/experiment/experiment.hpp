@@ -63,10 +63,10 @@ struct Experiment {
     int64_t frames = 1;
     std::vector<double> lenses_mm;            // the focal lengths the rig has
     double baseline_min_mm = 0, baseline_max_mm = 0;
-    double pixel_pitch_um = 0;                // for the sensor-aware figures (0: from the rig)
-    int image_width_px = 0;
-    int image_height_px = 0;
-    int min_disparity_px = 0, num_disparities = 0; // the matcher's search (disparity_search_px), for the minimum range
+    // The head's sensor and matcher (method::StereoDesign, the one head description):
+    // pixel pitch (0: unknown, no sensor-aware columns), image size, the matcher's search
+    // (disparity_search_px, for the minimum range). Each test configures its B, f, hc, θ.
+    method::StereoDesign head;
     std::vector<std::string> overrides;       // --set texts applied to the file
     std::map<std::string, std::vector<std::string>> bind; // variable -> rig paths
     std::vector<ExperimentTest> tests;
@@ -119,6 +119,9 @@ struct ExperimentOptions {
     bool progress = true;
     std::vector<std::string> only; // test ids to run; empty = all
     int shard_index = 1, shard_count = 1; // --shard K/N: the tests whose position p (0-based, file order) has p % N == K - 1
+    // --force: replace another experiment's results in out_dir (this experiment's own are
+    // replaced by a run of every test anyway; a partial run never replaces a table).
+    bool replace = false;
 };
 
 // One row of results.csv / results.json: a test's variables and every figure measured.
@@ -146,13 +149,19 @@ std::pair<int, int> parseShard(const std::string &text);
 // Joins the results.json of shards (or partial runs) of one experiment in `dirs` into
 // `out_dir`: the rows in the experiment's test order, the predictors' rho and the charts
 // recomputed over all of them, each test's folder copied. Throws when two folders hold
-// the same test, when they come from different experiments, or when a test is missing.
-ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host);
+// the same test, when they come from different experiments, when the experiment or its
+// rig changed since a folder was written, or when `out_dir` (not one of `dirs`) holds
+// results and `replace` is false. A set that lacks tests is merged with status
+// "partial" and its `missing_tests` listed (a warning says which).
+ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::vector<std::string> &dirs, const PluginHost &host,
+                                        bool replace = false);
 
 // Runs every test and writes results.csv, results.json, charts and per-test outputs
 // into out_dir/test_<id>/. Returns the rows it wrote. A test whose pipeline fails is
 // recorded with its error and the others still run; the caller decides the exit status
-// from `failed`.
+// from `failed`. results.json's `status` is "interrupted" until the last test is done,
+// then "complete" (every test) or "partial" (--tests, --shard). Refuses unknown --tests
+// ids, and results already in out_dir that this run must not replace (ExperimentOptions).
 ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, const ExperimentOptions &options);
 
 } // namespace binocle

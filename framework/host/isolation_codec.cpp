@@ -450,6 +450,9 @@ void putEvaluate(Writer &w, Layout &layout, const binocle_eval_input &in, bool s
     w.put<uint8_t>(!sendRig);
     if (sendRig) w.cstr(in.rig_yaml);
     w.cstr(in.output_dir);
+    // What the host knows of the matcher's search and the ground pose (appended members).
+    w.put<int32_t>(in.min_disparity).put<int32_t>(in.num_disparities).put<int32_t>(in.ground_pose_known);
+    w.put<double>(in.camera_height_mm).put<double>(in.inclination_deg);
 }
 
 void getEvaluate(Reader &r, Region region, EvaluateTexts &texts, EvaluateInput &out) {
@@ -467,6 +470,11 @@ void getEvaluate(Reader &r, Region region, EvaluateTexts &texts, EvaluateInput &
     out.output = r.cstr();
     binocle_eval_input &in = out.in;
     in = binocle_eval_input{};
+    in.min_disparity = r.get<int32_t>();
+    in.num_disparities = r.get<int32_t>();
+    in.ground_pose_known = r.get<int32_t>();
+    in.camera_height_mm = r.get<double>();
+    in.inclination_deg = r.get<double>();
     in.struct_size = sizeof in;
     in.frame = hasFrame ? &out.frame : nullptr;
     in.rectified_left = has[0] ? &out.images[0] : nullptr;

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The one strict reader of numbers in untrusted text.
+// The one strict reader of numbers in untrusted text: the SDK's (binocle/numbers.hpp),
+// with the range checks the framework's callers share.
 #include "input/numbers.hpp"
 
-#include <binocle/text.hpp>
+#include <binocle/numbers.hpp>
 
 #include <cerrno>
 #include <climits>
@@ -13,8 +14,6 @@
 namespace binocle::input {
 
 namespace {
-
-bool isDigit(char c) { return c >= '0' && c <= '9'; }
 
 bool fail(std::string *why, const std::string &text) {
     if (why) *why = text;
@@ -33,49 +32,7 @@ bool parseInteger(std::string_view text, int64_t &out, std::string *why, int64_t
 }
 
 bool parseReal(std::string_view text, double &out, std::string *why, bool allowNonFinite) {
-    if (allowNonFinite) {
-        std::string lower(text);
-        for (char &c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        if (lower == ".inf" || lower == "+.inf" || lower == "inf" || lower == "+inf") {
-            out = HUGE_VAL;
-            return true;
-        }
-        if (lower == "-.inf" || lower == "-inf") {
-            out = -HUGE_VAL;
-            return true;
-        }
-        if (lower == ".nan" || lower == "nan") {
-            out = std::nan("");
-            return true;
-        }
-    }
-    // Grammar first, so that strtod's extras (hex floats, "inf", "nan", leading spaces)
-    // never get through.
-    size_t i = 0;
-    if (i < text.size() && (text[i] == '-' || text[i] == '+')) ++i;
-    size_t digits = 0;
-    while (i < text.size() && isDigit(text[i])) ++i, ++digits;
-    if (i < text.size() && text[i] == '.') {
-        ++i;
-        while (i < text.size() && isDigit(text[i])) ++i, ++digits;
-    }
-    if (digits == 0) return fail(why, allowNonFinite ? "expected a decimal number (or .inf, .nan)" : "expected a decimal number");
-    if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
-        ++i;
-        if (i < text.size() && (text[i] == '-' || text[i] == '+')) ++i;
-        size_t exp = 0;
-        while (i < text.size() && isDigit(text[i])) ++i, ++exp;
-        if (exp == 0) return fail(why, "expected a decimal number (the exponent has no digits)");
-    }
-    if (i != text.size()) return fail(why, "expected a decimal number");
-    const std::string copy(text);
-    errno = 0;
-    char *end = nullptr;
-    const double v = std::strtod(copy.c_str(), &end);
-    if (end != copy.c_str() + copy.size()) return fail(why, "expected a decimal number");
-    if (errno == ERANGE && std::isinf(v)) return fail(why, "expected a number within the range of a double (about 1.8e308)");
-    out = v; // underflow to 0 or a denormal is fine
-    return true;
+    return sdk::parseDecimalReal(text, out, why, allowNonFinite);
 }
 
 bool fitsInt(double v) { return std::isfinite(v) && v > static_cast<double>(INT_MIN) - 1.0 && v < static_cast<double>(INT_MAX) + 1.0; }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The one strict reader of numbers in untrusted text (YAML values, --set, CSV cells,
-// calibration files): decimal only, whole text, range-checked before any cast.
+// The one strict reader of numbers in untrusted text (YAML values, --set, command-line
+// options, CSV cells, calibration files): decimal only, whole text, range-checked before
+// any cast. The rule itself lives in the SDK (binocle/numbers.hpp) so plugins share it.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +18,7 @@ bool parseInteger(std::string_view text, int64_t &out, std::string *why = nullpt
                   int64_t max = INT64_MAX);
 
 // A decimal real number: [sign] digits [. digits] [e [sign] digits], or ".5". Refused:
-// hexadecimal floats, "nan", "inf" (unless allowNonFinite: then also ".inf", "-.inf",
+// a leading zero before another digit ("010", "010.5"; "0.5" is fine), hexadecimal floats, "nan", "inf" (unless allowNonFinite: then also ".inf", "-.inf",
 // ".nan" as YAML writes them), values that overflow a double (1e999) and trailing text.
 bool parseReal(std::string_view text, double &out, std::string *why = nullptr, bool allowNonFinite = false);
 

@@ -18,6 +18,14 @@ inline constexpr double kFairFormFactorMin = 1.0;
 inline constexpr double kViderePixelPitchUm = 20.8;
 inline constexpr int kVidereImageWidthPx = 320, kVidereImageHeightPx = 240;
 inline constexpr const char *kVidereLensesMm = "2.8,4,8,12,16";
+// Δd: the matching error (px) the depth resolution is quoted for, everywhere (design,
+// experiments, the paper evaluator's default): a quarter pixel, what a sub-pixel
+// matcher such as SGBM resolves on a textured panel.
+inline constexpr double kMatchingErrorPx = 0.25;
+// hc when nobody says: the paper's vehicle carries its head 1.5 m above the ground.
+inline constexpr double kDefaultCameraHeightMm = 1500;
+// The matcher's search `design` assumes when not told (the E1 rig's SGBM: 64 from 0).
+inline constexpr int kDefaultNumDisparities = 64;
 
 // How far FF lies from the best band (0 inside), in log terms so that 0.6 and 4.0 (both
 // a factor 2 off) weigh alike.
@@ -45,7 +53,8 @@ double fieldOfViewDeg(int pixels, double pixel_pitch_um, double focal_length_mm)
 // Width the same pixels cover at range R (mm): R * N * p / f.
 double fieldWidthMm(double range_mm, int pixels, double pixel_pitch_um, double focal_length_mm);
 
-// A stereo head: what Eq. 7 and the figures need. Lengths in mm, pitch in um.
+// The head description: a stereo head, what Eq. 7 and the figures need. One struct for
+// `design`, experiments and the paper evaluator. Lengths in mm, pitch in um.
 struct StereoDesign {
     double baseline_mm = 0;
     double focal_length_mm = 0;
@@ -53,11 +62,32 @@ struct StereoDesign {
     int image_width_px = 0, image_height_px = 0;
     int min_disparity_px = 0;     // the matcher's search; num_disparities 0 = unknown
     int num_disparities = 0;
-    double camera_height_mm = 1500; // hc and theta of Eq. 1, for the vertical field
+    double camera_height_mm = kDefaultCameraHeightMm; // hc and theta of Eq. 1, for the vertical field
     double inclination_deg = 0;
 
     double focalLengthPx() const { return focal_length_mm * 1000.0 / pixel_pitch_um; }
+    // The same sensor and matcher in one configuration: baseline, lens, camera height
+    // and inclination (a test of an experiment, a candidate of `design`).
+    StereoDesign configured(double baseline, double focal_length, double camera_height, double inclination) const {
+        StereoDesign d = *this;
+        d.baseline_mm = baseline;
+        d.focal_length_mm = focal_length;
+        d.camera_height_mm = camera_height;
+        d.inclination_deg = inclination;
+        return d;
+    }
 };
+
+// The paper's Videre head as its experiments used it (no baseline or lens yet), with the
+// E1 rig's disparity search.
+inline StereoDesign videreHead() {
+    StereoDesign d;
+    d.pixel_pitch_um = kViderePixelPitchUm;
+    d.image_width_px = kVidereImageWidthPx;
+    d.image_height_px = kVidereImageHeightPx;
+    d.num_disparities = kDefaultNumDisparities;
+    return d;
+}
 
 // A test panel standing in the field of view (ground frame, mm).
 struct PanelPlacement {
@@ -89,7 +119,7 @@ struct DesignFigures {
 
 // All figures of `design` at range R. Values that need a missing input (image size,
 // disparity search) are NaN. Throws std::invalid_argument when B, f, p or R is not positive.
-DesignFigures designFigures(const StereoDesign &design, double range_mm, double matching_error_px = 0.25,
+DesignFigures designFigures(const StereoDesign &design, double range_mm, double matching_error_px = kMatchingErrorPx,
                             const PanelPlacement *panel = nullptr);
 
 } // namespace binocle::method

@@ -41,6 +41,6 @@ struct PredictorValues {
 };
 
 PredictorValues predictors(const StereoDesign &design, double range_mm, const PanelPlacement &panel,
-                           double matching_error_px = 0.25);
+                           double matching_error_px = kMatchingErrorPx);
 
 } // namespace binocle::method

@@ -148,6 +148,22 @@ std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
     }
 }
 
+// The pose of Eq. 1 for the evaluators: the settings camera_height_mm and
+// inclination_deg of the first transform that declares both (cloud_transform.h).
+void putGroundPose(binocle_eval_input &in, const RigConfig &rig) {
+    auto number = [](const binocle_param *p) {
+        return p->type == BINOCLE_PARAM_INT ? static_cast<double>(p->i) : p->d;
+    };
+    for (const auto &t : rig.transforms) {
+        const binocle_param *h = t.params.find("camera_height_mm"), *i = t.params.find("inclination_deg");
+        if (!h || !i) continue;
+        in.ground_pose_known = 1;
+        in.camera_height_mm = number(h);
+        in.inclination_deg = number(i);
+        return;
+    }
+}
+
 } // namespace
 
 Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
@@ -496,6 +512,9 @@ void Pipeline::evaluate(RunState &s) {
                 in.calibration_yaml = calibrationYaml_.c_str();
                 in.rig_yaml = rig_.resolved_yaml.c_str();
                 in.output_dir = outDir_.empty() ? nullptr : outDir_.c_str();
+                in.min_disparity = disparityRange_.first;
+                in.num_disparities = disparityRange_.second;
+                putGroundPose(in, rig_);
                 for (auto &slot : evaluators_) {
                     Json figures = Json::object();
                     slot->target = &figures;

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
+#include "rosbag/rosbag_recording.hpp"
 
 #include <binocle/recording.hpp>
 
@@ -510,14 +511,12 @@ nlohmann::ordered_json recordingSummary(const RecordResult &r) {
     return j;
 }
 
-RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
-                       const std::function<void(int64_t frames)> &onFrame) {
-    Source source(*rig.source.record, rig.source.params);
-    std::string calibration;
-    if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
-    else calibration = source.calibration();
-    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
+namespace {
 
+// The recording loop, the same for each format's writer (RecordingWriter, RosbagRecordingWriter).
+template <typename Writer>
+RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, const RecordOptions &options,
+                        const std::function<void(int64_t frames)> &onFrame) {
     RecordResult result;
     bool live = false;
     try {
@@ -574,6 +573,24 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
         spdlog::warn("record: {}", e.what());
     }
     return result;
+}
+
+} // namespace
+
+RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
+                       const std::function<void(int64_t frames)> &onFrame) {
+    Source source(*rig.source.record, rig.source.params);
+    std::string calibration;
+    if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
+    else calibration = source.calibration();
+    if (options.format == "mcap") {
+        RosbagRecordingWriter writer(dir, calibration, rig.resolved_yaml, options.rosbag, options.writer);
+        return recordWith(writer, source, dir, options, onFrame);
+    }
+    if (options.format != "folder")
+        throw Error("record: format '" + options.format + "': expected folder or mcap");
+    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
+    return recordWith(writer, source, dir, options, onFrame);
 }
 
 } // namespace binocle

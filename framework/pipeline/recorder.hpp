@@ -6,6 +6,7 @@
 
 #include "config/rig_config.hpp"
 #include "host/plugin_host.hpp"
+#include "rosbag/rosbag_writer.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -99,6 +100,9 @@ struct RecordOptions {
     // wait for any other (files, simulation: nothing is lost).
     std::optional<bool> drop_when_behind;
     RecordingWriterOptions writer;
+    // "folder" (PNG + frames.csv) or "mcap": a rosbag2 bag (rosbag/rosbag_recording.hpp).
+    std::string format = "folder";
+    RosbagOptions rosbag;
 };
 
 struct RecordResult {

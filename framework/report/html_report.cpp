@@ -8,6 +8,7 @@
 #include "report/web_files.hpp"
 
 #include <boost/beast/core/detail/base64.hpp>
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
@@ -38,8 +39,7 @@ std::string readFile(const fs::path &p) {
     return os.str();
 }
 
-std::string dataUri(const fs::path &p, const std::string &mime) {
-    const std::string bytes = readFile(p);
+std::string dataUri(const std::string &bytes, const std::string &mime) {
     std::string out(boost::beast::detail::base64::encoded_size(bytes.size()), '\0');
     out.resize(boost::beast::detail::base64::encode(out.data(), bytes.data(), bytes.size()));
     return "data:" + mime + ";base64," + out;
@@ -244,7 +244,21 @@ std::string charts(const fs::path &dir) {
     return os.str();
 }
 
-std::string testSections(const fs::path &dir, const OJson &results) {
+// A PNG that is whole: its signature, and its last chunk IEND where the file ends (a
+// copy or a write cut short loses the end first).
+bool wholePng(const std::string &bytes) {
+    static const std::string kSignature("\x89PNG\r\n\x1a\n", 8);
+    static const std::string kEnd("IEND\xae\x42\x60\x82", 8);
+    return bytes.size() >= kSignature.size() + 12 && bytes.compare(0, kSignature.size(), kSignature) == 0 &&
+           bytes.compare(bytes.size() - kEnd.size(), kEnd.size(), kEnd) == 0;
+}
+
+// Images a test that ran should have and that the report could not show.
+struct ImageProblems {
+    std::vector<std::string> missing, unreadable; // "test_3: top view (XY)", "test_3/paper_top_000000.png"
+};
+
+std::string testSections(const fs::path &dir, const OJson &results, ImageProblems &problems) {
     std::ostringstream os;
     for (const auto &row : results["tests"]) {
         const std::string id = row.value("test", std::string());
@@ -264,18 +278,45 @@ std::string testSections(const fs::path &dir, const OJson &results) {
                               {"paper_top_", "top view (XY)"},
                               {"paper_front_", "front view (XZ)"},
                               {"paper_side_", "side view (YZ)"}};
+        const bool ran = row.value("status", std::string("ok")) == "ok";
         for (const Item &item : items) {
             const auto file = firstFile(t, item.prefix, ".png");
+            const std::string bytes = file ? readFile(*file) : std::string();
             os << "<figure>";
-            if (file)
-                os << "<img alt=\"test " << escape(id) << " " << item.label << "\" src=\"" << dataUri(*file, "image/png") << "\">";
-            else
+            if (file && wholePng(bytes)) {
+                os << "<img alt=\"test " << escape(id) << " " << item.label << "\" src=\"" << dataUri(bytes, "image/png") << "\">";
+            } else if (file) {
+                const std::string name = t.filename().string() + "/" + file->filename().string();
+                problems.unreadable.push_back(name);
+                os << "<div class=\"missing\">" << escape(name) << " is truncated or not a PNG</div>";
+            } else {
+                if (ran) problems.missing.push_back(t.filename().string() + ": " + item.label);
                 os << "<div class=\"missing\">no " << item.label << " image in " << escape(t.filename().string()) << "</div>";
+            }
             os << "<figcaption>" << item.label << (file ? " · " + escape(file->filename().string()) : "") << "</figcaption></figure>";
         }
         os << "</div></section>";
     }
     return os.str();
+}
+
+// What makes results.json less than the whole experiment, in words; "" when complete
+// (or written before binocle said: no `status`).
+std::string incompleteness(const OJson &results) {
+    const std::string status = results.value("status", std::string());
+    const size_t rows = results["tests"].size();
+    const size_t all = results.contains("test_ids") && results["test_ids"].is_array() ? results["test_ids"].size() : rows;
+    std::string missing;
+    if (results.contains("missing_tests") && results["missing_tests"].is_array())
+        for (const auto &id : results["missing_tests"])
+            if (id.is_string()) missing += (missing.empty() ? "" : ", ") + id.get<std::string>();
+    if (status == "interrupted")
+        return "the run stopped after " + std::to_string(rows) + " of " + std::to_string(all) + " tests (status: interrupted)";
+    if (status == "partial")
+        return std::to_string(rows) + " of " + std::to_string(all) + " tests (status: partial" +
+               (missing.empty() ? std::string(", a share of the tests") : "; missing: " + missing) + ")";
+    if (!status.empty() && status != "complete") return "status '" + status + "' is not one binocle writes";
+    return "";
 }
 
 std::string provenance(const OJson &results) {
@@ -355,10 +396,19 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
     std::strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", std::gmtime(&written));
     size_t ok = 0;
     for (const auto &row : results["tests"]) ok += row.value("status", std::string()) == "ok";
+    ImageProblems problems;
+    const std::string tests = testSections(dir, results, problems);
 
     std::ostringstream summary;
+    const std::string incomplete = incompleteness(results);
+    if (!incomplete.empty()) summary << "INCOMPLETE: " << incomplete << " · ";
     summary << results["tests"].size() << " tests, " << ok << " ok · results of " << when;
     if (!paper.empty()) summary << " · the paper's values for " << paper.size() << " tests";
+    if (!problems.missing.empty() || !problems.unreadable.empty())
+        summary << " · images: " << problems.missing.size() << " missing, " << problems.unreadable.size() << " unreadable";
+    if (!incomplete.empty()) spdlog::warn("report {}: incomplete results: {}", dirText, incomplete);
+    for (const auto &m : problems.missing) spdlog::warn("report {}: no image for {}", dirText, m);
+    for (const auto &u : problems.unreadable) spdlog::warn("report {}: {} is truncated or not a PNG: not shown", dirText, u);
 
     const std::string html = fill(embedded("report.html"), {{"TITLE", escape("Binocle experiment " + name)},
                                                             {"NAME", escape(name)},
@@ -370,7 +420,7 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
                                                             {"FULL_TABLE", fullTable(results)},
                                                             {"PAPER_CHART", paperChart(results, paper)},
                                                             {"CHARTS", charts(dir)},
-                                                            {"TESTS", testSections(dir, results)},
+                                                            {"TESTS", tests},
                                                             {"PROVENANCE", provenance(results)}});
     const std::string output = outputText.empty() ? (dir / "report.html").string() : outputText;
     writeFileAtomic(output, html);

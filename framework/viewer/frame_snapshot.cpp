@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/image_io.hpp"
 #include "method/density_render.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -215,7 +216,7 @@ std::vector<std::string> writeSnapshot(const FrameProducts &p, const OutputOptio
     const char *names[] = {"top", "front", "side"};
     for (size_t i = 0; i < views.size(); ++i) {
         const std::string path = (fs::path(dir) / ("view_" + std::string(names[i]) + "_" + stem + ".png")).string();
-        method::writePngAtomic(path, views[i]);
+        writeImage(path, views[i]); // core's safe temporary, like every other output
     }
     OJson frame = OJson::object();
     frame["sequence"] = p.result.sequence;

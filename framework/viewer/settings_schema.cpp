@@ -2,6 +2,8 @@
 // Controls from the plugins' settings tables.
 #include "viewer/settings_schema.hpp"
 
+#include "viewer/page_settings.hpp"
+
 #include <sstream>
 
 namespace binocle::viewer {
@@ -35,6 +37,7 @@ OJson block(const PluginBlock &b, const std::string &key) {
             if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) p["max"] = d.max;
             if (d.multiple_of > 0) p["multiple_of"] = d.multiple_of;
             if (d.flags & BINOCLE_PARAM_FLAG_ODD) p["odd"] = true;
+            if (d.flags & BINOCLE_PARAM_FLAG_LIMIT) p["limit"] = true; // shown, not a control
             if (d.choices) {
                 OJson choices = OJson::array();
                 std::stringstream ss(d.choices);
@@ -73,10 +76,7 @@ std::string paramText(const binocle_param &p) {
 
 OJson settingsSchema(const RigConfig &rig) {
     OJson blocks = OJson::array();
-    blocks.push_back(block(rig.source, "source"));
-    blocks.push_back(block(rig.matcher, "matcher"));
-    for (size_t i = 0; i < rig.transforms.size(); ++i) blocks.push_back(block(rig.transforms[i], "transforms." + std::to_string(i)));
-    for (size_t i = 0; i < rig.evaluators.size(); ++i) blocks.push_back(block(rig.evaluators[i], "evaluators." + std::to_string(i)));
+    for (const auto &[b, key] : pluginBlocks(rig)) blocks.push_back(block(*b, key));
     return blocks;
 }
 

@@ -11,7 +11,8 @@ namespace binocle::viewer {
 
 // [{"key": "matcher", "where": "matcher", "plugin": "sgbm", "kind": "matcher",
 //   "params": [{"name", "type" ("int", "double", "bool", "enum", "string", "path", "yaml",
-//   "int_list", "double_list"), "min", "max", "multiple_of", "odd", "choices", "unit",
+//   "int_list", "double_list"), "min", "max", "multiple_of", "odd", "limit" (a resource
+//   limit: shown, not changed from the page), "choices", "unit",
 //   "help", "default", "value" (YAML text), "explicit"}]}]
 // `key` is the --set prefix of the block ("transforms.0").
 nlohmann::ordered_json settingsSchema(const RigConfig &rig);

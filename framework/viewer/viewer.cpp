@@ -7,10 +7,14 @@
 
 #include "core/error.hpp"
 #include "pipeline/pipeline.hpp"
+#include "viewer/command.hpp"
 #include "viewer/frame_snapshot.hpp"
+#include "viewer/page_settings.hpp"
 #include "viewer/server.hpp"
 #include "viewer/settings_schema.hpp"
+#include "viewer/web_guard.hpp"
 
+#include <binocle/text.hpp>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
@@ -23,6 +27,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -35,10 +40,29 @@ using Clock = std::chrono::steady_clock;
 
 std::string dumpJson(const OJson &j) { return j.dump(-1, ' ', false, OJson::error_handler_t::replace); }
 
+// An error for the page: a message from the rig's validation or a plugin, escaped and cut
+// (it may quote what a page sent).
+OJson errorReply(const std::string &op, const std::string &message) {
+    return {{"type", "error"}, {"op", op}, {"message", sdk::printable(message, 600)}};
+}
+
+// Refuses a non-loopback bind without --allow-remote; warns about what is allowed.
+void checkExposure(const ViewOptions &options) {
+    const std::string risk = remoteBindRisk(options.address);
+    if (!risk.empty() && !options.allow_remote)
+        throw Error("view: " + risk + ". Add --allow-remote to serve it anyway, or leave --bind at 127.0.0.1 and reach it "
+                    "through an SSH tunnel (docs/security.md)");
+    if (!risk.empty()) spdlog::warn("view: {}", risk);
+    if (::geteuid() == 0)
+        spdlog::warn("view: running as root: whoever holds the page's token writes snapshots with root's rights; run binocle "
+                     "view as an ordinary user");
+}
+
 class View {
 public:
     View(const ViewOptions &options, const PluginHost &host) : options_(options), host_(host) {
         rig_ = loadRig(options.rig_file, options.overrides, host);
+        page_ = std::make_unique<PageSettings>(rig_);
         paused_ = options.paused;
         step_ = options.paused; // paused from the start: one frame to look at
         updateWanted();
@@ -56,7 +80,7 @@ public:
             cloudWanted_ = true; // a new page: its 3D view gets the next frame's cloud
             return dumpJson(state(true));
         };
-        h.command = [this](const std::string &c) { return command(c); };
+        h.command = [this](const std::string &c) { return command(c); }; // the server's command thread
         h.api = [this](const std::string &name) { return api(name); };
         h.lastFrame = [this] {
             std::lock_guard<std::mutex> lock(lastMutex_);
@@ -69,7 +93,13 @@ public:
         sigaddset(&signals, SIGTERM);
         pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-        server_ = std::make_unique<Server>(options_.address, static_cast<uint16_t>(options_.port), makeToken(), h);
+        checkExposure(options_);
+        ServerOptions serving;
+        serving.address = options_.address;
+        serving.port = static_cast<uint16_t>(options_.port);
+        serving.token = makeToken();
+        serving.allowed_hosts = options_.allowed_hosts;
+        server_ = std::make_unique<Server>(serving, h);
         if (listening) listening(server_->url());
         std::thread encoder([this] { encoderLoop(); });
         std::thread pipeline([this] { pipelineLoop(); });
@@ -95,6 +125,7 @@ public:
         }
         slotCv_.notify_all();
         encoder.join();
+        server_->stop(); // no command runs past here
         server_.reset();
         pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);
 
@@ -193,11 +224,11 @@ private:
                     lastChange_ = "applied";
                 } else {
                     lastChange_ = "refused";
-                    spdlog::warn("view: a plugin refused the change: {}", failure);
+                    spdlog::warn("view: a plugin refused the change: {}", logExcerpt(failure));
                 }
                 lock.unlock();
                 broadcastState();
-                if (!failure.empty()) server_->broadcastText(dumpJson({{"type", "error"}, {"message", failure}}));
+                if (!failure.empty()) server_->broadcastText(dumpJson(errorReply("set", failure)));
                 lock.lock();
                 if (paused_) step_ = true; // show what the change does
                 updateWanted();
@@ -319,7 +350,7 @@ private:
         return s;
     }
     void broadcastState() {
-        if (server_) server_->broadcastText(dumpJson(state(false)));
+        if (server_) server_->broadcastState(dumpJson(state(false)));
     }
 
     static std::string setLines(const std::vector<Override> &overrides) {
@@ -329,44 +360,54 @@ private:
     }
 
     std::string command(const std::string &text) {
-        const OJson c = OJson::parse(text, nullptr, false);
-        if (c.is_discarded() || !c.is_object() || !c.contains("op") || !c["op"].is_string())
-            return dumpJson({{"type", "error"}, {"message", "view: a command is a JSON object with \"op\""}});
-        const std::string op = c["op"];
-        OJson reply = {{"type", "ok"}, {"op", op}};
-        if (op == "set") {
-            if (!c.contains("key") || !c["key"].is_string() || !c.contains("value") || !c["value"].is_string())
-                return dumpJson({{"type", "error"}, {"op", op}, {"message", "view: set needs \"key\" and \"value\" (YAML text)"}});
-            return dumpJson(set(c["key"], c["value"]));
-        } else if (op == "pause" || op == "resume") {
+        Command c;
+        try {
+            c = parseCommand(text);
+        } catch (const CommandError &e) {
+            OJson r = errorReply(e.op, e.what());
+            if (!e.key.empty()) r["key"] = e.key;
+            return dumpJson(r);
+        }
+        OJson reply = {{"type", "ok"}, {"op", c.name}};
+        switch (c.op) {
+        case Op::Set: return dumpJson(set(c.key, c.value));
+        case Op::Reset: return dumpJson(applyOverrides(options_.overrides, "reset"));
+        case Op::Snapshot: return dumpJson(snapshot());
+        case Op::Pause:
+        case Op::Resume: {
             std::lock_guard<std::mutex> lock(mutex_);
-            paused_ = op == "pause";
+            paused_ = c.op == Op::Pause;
             updateWanted();
-        } else if (op == "step") {
+            break;
+        }
+        case Op::Step: {
             std::lock_guard<std::mutex> lock(mutex_);
             paused_ = true;
             step_ = true;
             updateWanted();
-        } else if (op == "restart") {
+            break;
+        }
+        case Op::Restart: {
             std::lock_guard<std::mutex> lock(mutex_);
             restart_ = true;
             updateWanted();
-        } else if (op == "reset") {
-            return dumpJson(applyOverrides(options_.overrides, "reset"));
-        } else if (op == "snapshot") {
-            return dumpJson(snapshot());
-        } else {
-            return dumpJson({{"type", "error"},
-                             {"op", op},
-                             {"message", "view: unknown command '" + op + "' (set, pause, resume, step, restart, reset, snapshot)"}});
+            break;
+        }
         }
         cv_.notify_all();
         broadcastState();
         return dumpJson(reply);
     }
 
-    // A change from the page goes through the host's validation exactly as --set does.
+    // A change from the page: a declared, non-limit plugin setting (page_), checked by the
+    // host's validation exactly as --set is, with its paths kept inside the rig's folders.
     OJson set(const std::string &key, const std::string &value) {
+        auto refused = [&](const std::string &why) {
+            OJson r = errorReply("set", why);
+            r["key"] = key;
+            return r;
+        };
+        if (const std::string why = page_->refuseKey(key); !why.empty()) return refused(why);
         std::vector<Override> candidate;
         {
             std::lock_guard<std::mutex> lock(mutex_);
@@ -376,23 +417,30 @@ private:
         try {
             o = Override::parse(key + "=" + value);
         } catch (const Error &e) {
-            return {{"type", "error"}, {"op", "set"}, {"key", key}, {"message", e.what()}};
+            return refused(e.what());
         }
         auto same = std::find_if(candidate.begin(), candidate.end(), [&](const Override &x) { return x.path == o.path; });
         if (same != candidate.end()) candidate.erase(same);
         candidate.push_back(o);
-        OJson r = applyOverrides(candidate, "set");
+        size_t bytes = 0;
+        for (const Override &x : candidate) bytes += x.path.size() + x.value.size();
+        if (bytes > kMaxPageSettingsBytes)
+            return refused("view: the settings changed from the page would hold " + std::to_string(bytes) + " bytes; expected at most " +
+                           std::to_string(kMaxPageSettingsBytes) + " (reset, or put large values in the rig file)");
+        OJson r = applyOverrides(candidate, "set", true);
         r["key"] = key;
         return r;
     }
 
-    OJson applyOverrides(const std::vector<Override> &overrides, const std::string &op) {
+    OJson applyOverrides(const std::vector<Override> &overrides, const std::string &op, bool fromPage = false) {
         RigConfig rig;
         try {
             rig = loadRig(options_.rig_file, overrides, host_);
         } catch (const std::exception &e) {
-            return {{"type", "error"}, {"op", op}, {"message", e.what()}};
+            return errorReply(op, e.what());
         }
+        if (fromPage)
+            if (const std::string why = page_->refusePaths(rig); !why.empty()) return errorReply(op, why);
         {
             std::lock_guard<std::mutex> lock(mutex_);
             lastChange_ = "pending";
@@ -418,7 +466,7 @@ private:
             std::lock_guard<std::mutex> lock(lastMutex_);
             p = last_;
         }
-        if (!p) return {{"type", "error"}, {"op", "snapshot"}, {"message", "view: no frame has been shown yet"}};
+        if (!p) return errorReply("snapshot", "view: no frame has been shown yet");
         OutputOptions outputs;
         std::string yaml;
         {
@@ -431,7 +479,7 @@ private:
             spdlog::info("view: frame {} written to {} ({} files)", p->result.sequence, options_.out_dir, files.size());
             return {{"type", "snapshot"}, {"sequence", p->result.sequence}, {"dir", fs::absolute(options_.out_dir).string()}, {"files", files}};
         } catch (const std::exception &e) {
-            return {{"type", "error"}, {"op", "snapshot"}, {"message", e.what()}};
+            return errorReply("snapshot", e.what());
         }
     }
 
@@ -439,8 +487,9 @@ private:
         if (name == "state") return {200, "application/json", dumpJson(state(false)), ""};
         if (name == "rig.yaml") {
             std::lock_guard<std::mutex> lock(mutex_);
-            std::string text = "# Saved by binocle view from " + rig_.file + "\n# with:\n";
-            for (const Override &o : overrides_) text += "#   --set " + o.path + "=" + o.value + "\n";
+            // Values are escaped in the comments: a line break in one must not end the comment.
+            std::string text = "# Saved by binocle view from " + sdk::printable(rig_.file, 400) + "\n# with:\n";
+            for (const Override &o : overrides_) text += "#   --set " + sdk::printable(o.path + "=" + o.value, 200) + "\n";
             text += "# Relative paths are relative to " + rig_.base_dir + ": save this file there.\n";
             text += rig_.resolved_yaml + "\n";
             return {200, "application/yaml; charset=utf-8", text, rig_.name + "-view.yaml"};
@@ -494,6 +543,7 @@ private:
     std::shared_ptr<const FrameProducts> last_;
     std::shared_ptr<const std::string> lastMessage_;
 
+    std::unique_ptr<PageSettings> page_; // what the page may change, from the rig as started
     std::unique_ptr<Server> server_;
 };
 

@@ -17,6 +17,8 @@ struct ViewOptions {
     std::string rig_file;
     std::vector<Override> overrides; // --set, before any change made in the page
     std::string address = "127.0.0.1";
+    bool allow_remote = false;       // a non-loopback address is refused without it
+    std::vector<std::string> allowed_hosts; // Host names served besides the address (--allow-host)
     int port = 8080;                 // 0: any free port
     std::string out_dir = "out/view"; // where snapshots go
     double display_fps = 2;          // most frames per second sent to the browsers
@@ -39,7 +41,8 @@ struct ViewSummary {
 
 // Serves until SIGINT or SIGTERM, or until max_frames frames. `listening` receives the
 // URL (with its token) once the server accepts connections. Throws binocle::Error when
-// the rig is invalid or the address cannot be bound.
+// the rig is invalid, the address cannot be bound, or it is not a loopback address and
+// allow_remote is not set. Warns when it runs as root or serves beyond loopback.
 ViewSummary runView(const ViewOptions &options, const PluginHost &host,
                     const std::function<void(const std::string &url)> &listening);
 

@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,13 @@ std::string fixed(double v, int decimals) {
     return buf;
 }
 
+// Δd's default as a setting's text, from the one constant `design` and experiments use.
+const std::string kMatchingErrorText = [] {
+    std::ostringstream os;
+    os << method::kMatchingErrorPx;
+    return os.str();
+}();
+
 class PaperEvaluator : public binocle::sdk::Evaluator {
 public:
     static std::vector<binocle_param_desc> parameters() {
@@ -97,12 +105,12 @@ public:
             Param::integer("min_panel_points", "50").min(1).help("fewer panel points: not registered (rejected)"),
             Param::boolean("write_views", false)
                 .help("write the top, front and side density views as PNG into the output folder"),
-            Param::real("matching_error_px", "0.25").min(0).unit("px")
+            Param::real("matching_error_px", kMatchingErrorText.c_str()).min(0).unit("px")
                 .help("matching error used for the depth resolution figure"),
-            Param::real("baseline_mm", "0").min(0).unit("mm").help("B for Eq. 7; 0: from the metadata, rig or calibration"),
-            Param::real("focal_length_mm", "0").min(0).unit("mm").help("f for Eq. 7; 0: from the metadata or rig"),
+            Param::real("baseline_mm", "0").min(0).unit("mm").help("B for Eq. 7; 0: from the metadata or calibration"),
+            Param::real("focal_length_mm", "0").min(0).unit("mm").help("f for Eq. 7; 0: from the metadata (or the calibration's focal_length_px and p)"),
             Param::real("pixel_pitch_um", "0").min(0).unit("um")
-                .help("effective pixel pitch; 0: from the metadata or rig"),
+                .help("effective pixel pitch; 0: from the metadata (or f and the calibration's focal_length_px)"),
             Param::string("object", "").help("e2: name of the known object in the metadata; empty: its main_object"),
             Param::realList("object_center_mm", "[]").unit("mm")
                 .help("e2: true centre [X, Y, Z] of the known object when the metadata has none"),
@@ -148,13 +156,14 @@ public:
             throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                         "paper evaluator needs the cloud in the ground frame: add the ground transform");
         const paper::FrameTruth truth = paper::parseFrameTruth(in.frame ? in.frame->metadata : nullptr);
-        const std::string rigText = in.rig_yaml ? in.rig_yaml : "", calibrationText = in.calibration_yaml ? in.calibration_yaml : "";
-        if (!rigParsed_ || rigText != rigText_ || calibrationText != calibrationText_) {
-            rig_ = paper::parseRigFacts(in.rig_yaml, in.calibration_yaml);
-            rigText_ = rigText;
+        const std::string calibrationText = in.calibration_yaml ? in.calibration_yaml : "";
+        if (!calibrationParsed_ || calibrationText != calibrationText_) {
+            calibration_ = paper::parseCalibrationFacts(in.calibration_yaml);
             calibrationText_ = calibrationText;
-            rigParsed_ = true;
+            calibrationParsed_ = true;
         }
+        rig_ = calibration_;
+        paper::addHostFacts(rig_, in);
         const method::CloudView cloud(*in.cloud);
         sequence_ = in.frame ? in.frame->sequence : frames_;
         ++frames_;
@@ -345,8 +354,8 @@ private:
             return kNaN;
         };
         d.baseline_mm = pick("baseline_mm", {truth.baseline_mm, rig_.baseline_mm});
-        d.focal_length_mm = pick("focal_length_mm", {truth.focal_length_mm, rig_.focal_length_mm});
-        d.pixel_pitch_um = pick("pixel_pitch_um", {truth.pixel_pitch_um, rig_.pixel_pitch_um});
+        d.focal_length_mm = pick("focal_length_mm", {truth.focal_length_mm});
+        d.pixel_pitch_um = pick("pixel_pitch_um", {truth.pixel_pitch_um});
         const std::optional<double> fpx = truth.focal_length_px ? truth.focal_length_px : rig_.focal_length_px;
         if (!(d.focal_length_mm > 0) && d.pixel_pitch_um > 0 && fpx) d.focal_length_mm = *fpx * d.pixel_pitch_um / 1000;
         if (!(d.pixel_pitch_um > 0) && d.focal_length_mm > 0 && fpx) d.pixel_pitch_um = d.focal_length_mm * 1000 / *fpx;
@@ -446,9 +455,9 @@ private:
     bool e2_ = false;
     method::GridSpec grid_;
     std::optional<std::vector<double>> objectCenter_, objectSize_;
-    paper::RigFacts rig_;
-    std::string rigText_, calibrationText_;
-    bool rigParsed_ = false;
+    paper::RigFacts calibration_, rig_; // the calibration's facts; with the host's of this frame
+    std::string calibrationText_;
+    bool calibrationParsed_ = false;
     bool designWarned_ = false, viewsWarned_ = false;
     uint64_t sequence_ = 0;
     int64_t frames_ = 0;

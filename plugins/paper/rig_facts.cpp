@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Frame metadata, rig and calibration, read for the paper evaluator.
+// Frame metadata, calibration and the host's facts, read for the paper evaluator.
 #include "paper/rig_facts.hpp"
 
 #include <binocle/plugin.hpp>
@@ -105,30 +105,8 @@ FrameTruth parseFrameTruth(const char *metadata) {
     return t;
 }
 
-RigFacts parseRigFacts(const char *rig_yaml, const char *calibration_yaml) {
+RigFacts parseCalibrationFacts(const char *calibration_yaml) {
     RigFacts f;
-    const YAML::Node rig = load(rig_yaml, "rig");
-    if (rig && rig.IsMap()) {
-        const YAML::Node source = rig["source"];
-        f.baseline_mm = scalar<double>(source, "baseline_mm", "rig, source");
-        f.focal_length_mm = scalar<double>(source, "focal_length_mm", "rig, source");
-        f.pixel_pitch_um = scalar<double>(source, "pixel_pitch_um", "rig, source");
-        f.image_width = scalar<int>(source, "image_width", "rig, source");
-        f.image_height = scalar<int>(source, "image_height", "rig, source");
-        const YAML::Node matcher = rig["matcher"];
-        f.min_disparity = scalar<int>(matcher, "min_disparity", "rig, matcher").value_or(0);
-        f.num_disparities = scalar<int>(matcher, "num_disparities", "rig, matcher").value_or(0);
-        if (const YAML::Node transforms = rig["transforms"]; transforms && transforms.IsSequence()) {
-            for (size_t i = 0; i < transforms.size(); ++i) {
-                const YAML::Node t = transforms[i];
-                if (!t.IsMap() || !t["plugin"] || t["plugin"].as<std::string>() != "ground") continue;
-                const std::string where = "rig, transforms[" + std::to_string(i) + "]";
-                f.ground_transform = true;
-                f.applied_inclination_deg = scalar<double>(t, "inclination_deg", where).value_or(0.0);
-                f.applied_camera_height_mm = scalar<double>(t, "camera_height_mm", where).value_or(1500.0);
-            }
-        }
-    }
     if (calibration_yaml && *calibration_yaml) {
         try {
             cv::FileStorage fs(calibration_yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
@@ -137,19 +115,27 @@ RigFacts parseRigFacts(const char *rig_yaml, const char *calibration_yaml) {
                 if (n.empty() || !(n.isReal() || n.isInt())) return std::nullopt;
                 return static_cast<double>(n);
             };
-            if (!f.baseline_mm) f.baseline_mm = real("baseline_mm");
+            f.baseline_mm = real("baseline_mm");
             f.focal_length_px = real("focal_length_px");
-            if (!f.image_width) {
-                if (auto w = real("image_width")) f.image_width = static_cast<int>(*w);
-            }
-            if (!f.image_height) {
-                if (auto h = real("image_height")) f.image_height = static_cast<int>(*h);
-            }
+            if (auto w = real("image_width")) f.image_width = static_cast<int>(*w);
+            if (auto h = real("image_height")) f.image_height = static_cast<int>(*h);
         } catch (const cv::Exception &) {
             // The pipeline has parsed it already; anything unreadable here only costs figures.
         }
     }
     return f;
+}
+
+void addHostFacts(RigFacts &f, const binocle_eval_input &in) {
+    if (BINOCLE_EVAL_INPUT_HAS(in, num_disparities)) {
+        f.min_disparity = in.min_disparity;
+        f.num_disparities = in.num_disparities;
+    }
+    f.ground_pose_known = BINOCLE_EVAL_INPUT_HAS(in, inclination_deg) && in.ground_pose_known;
+    if (f.ground_pose_known) {
+        f.applied_camera_height_mm = in.camera_height_mm;
+        f.applied_inclination_deg = in.inclination_deg;
+    }
 }
 
 } // namespace binocle::paper

@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: MIT
 // What the paper evaluator learns from its input besides the cloud: the truth the
-// source attaches to a frame (metadata YAML) and the head's geometry (rig YAML,
-// calibration YAML).
+// source attaches to a frame (metadata YAML), the head's calibration (calibration YAML)
+// and what the host learnt through the other plugins' tables (the matcher's search, the
+// ground frame's pose). No other plugin's settings are read: the evaluator works with
+// any matcher and any transform that makes the ground frame.
 #pragma once
 
+#include "method/design.hpp"
 #include "method/ground_plane.hpp"
+
+#include <binocle/abi.h>
 
 #include <optional>
 #include <string>
@@ -29,19 +34,22 @@ struct FrameTruth {
 // frame metadata and the key when a present key is malformed.
 FrameTruth parseFrameTruth(const char *metadata);
 
-// The head as the rig and calibration describe it.
+// The head as the calibration and the host describe it.
 struct RigFacts {
-    std::optional<double> baseline_mm, focal_length_mm, pixel_pitch_um, focal_length_px;
+    // From the calibration (OpenCV FileStorage: baseline_mm, focal_length_px, image_width/height).
+    std::optional<double> baseline_mm, focal_length_px;
     std::optional<int> image_width, image_height;
-    int min_disparity = 0, num_disparities = 0;   // the matcher's search (0: unknown)
-    bool ground_transform = false;                // a `ground` transform is listed
-    double applied_inclination_deg = 0;           // its inclination_deg (Eq. 1), default 0
-    double applied_camera_height_mm = 1500;       // its camera_height_mm, default 1500
+    // From the host: the matcher's disparity_range (0: unknown) and the pose of Eq. 1 the
+    // transform that made the ground frame applied (its defaults when none says).
+    int min_disparity = 0, num_disparities = 0;
+    bool ground_pose_known = false;
+    double applied_inclination_deg = 0;
+    double applied_camera_height_mm = method::kDefaultCameraHeightMm;
 };
 
-// rig_yaml: source block (baseline_mm, focal_length_mm, pixel_pitch_um, image_width,
-// image_height), matcher block (min_disparity, num_disparities), transforms (ground).
-// calibration_yaml: OpenCV FileStorage (baseline_mm, focal_length_px, image_width/height).
-RigFacts parseRigFacts(const char *rig_yaml, const char *calibration_yaml);
+// The calibration's part of RigFacts (null or empty: nothing known).
+RigFacts parseCalibrationFacts(const char *calibration_yaml);
+// Adds what the host passed in `in` (only the members its struct_size reaches).
+void addHostFacts(RigFacts &facts, const binocle_eval_input &in);
 
 } // namespace binocle::paper

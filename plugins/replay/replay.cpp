@@ -2,11 +2,13 @@
 // replay: a StereoSource that plays stereo pairs back from files: glob patterns,
 // Middlebury scenes, a KITTI tree or a folder written by `binocle record`.
 //
-// Read top to bottom: settings, what a layout yields (a list of frames and a
-// calibration), the four layouts and their detection, the source itself, and the
-// registration line at the very end. The file formats are described in README.md.
+// Read top to bottom: settings, the layouts (what a layout yields is in replay_plan.hpp;
+// the rosbag2 MCAP bags of layout mcap in replay_mcap.hpp) and their detection, the
+// source itself, and the registration line at the very end. The file formats are
+// described in README.md.
 #include "replay_files.hpp"
 #include "replay_metadata.hpp"
+#include "replay_plan.hpp"
 
 #include "common/frame_pacer.hpp"
 #include "input/image_file.hpp"
@@ -14,6 +16,7 @@
 
 #include <binocle/plugin.hpp>
 #include <binocle/recording.hpp>
+#include <binocle/settings.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -45,7 +48,7 @@ using sdk::Error;
 std::vector<binocle_param_desc> parameterTable() {
     using sdk::Param;
     return {
-        Param::choice("layout", "auto", "auto|glob|middlebury|kitti|recording")
+        Param::choice("layout", "auto", "auto|glob|middlebury|kitti|recording|mcap")
             .help("how the files are laid out; auto: glob when left/right are set, else detected from folder"),
         Param::path("left", "").help("glob layout: pattern of the left images, e.g. /data/run1/left_*.png"),
         Param::path("right", "").help("glob layout: pattern of the right images, as many as the left ones"),
@@ -55,6 +58,13 @@ std::vector<binocle_param_desc> parameterTable() {
             .help("ground-truth disparities are multiplied by this after decoding (e.g. 0.5 for a half-size pair)"),
         Param::path("folder", "")
             .help("middlebury (a scene folder, a folder of scenes or a glob over scene folders), kitti or recording folder"),
+        Param::path("bag", "").help("mcap: a rosbag2 MCAP file (.mcap) or a rosbag2 folder (metadata.yaml)"),
+        Param::string("left_topic", "").help("mcap: the left image topic (default: the bag's */left/X + */right/X pair)"),
+        Param::string("right_topic", "").help("mcap: the right image topic"),
+        Param::real("pair_tolerance_ms", "5").min(0).unit("ms")
+            .help("mcap: largest difference of the header stamps of a pair; images without a partner are counted"),
+        Param::real("start_s", "0").min(0).unit("s").help("mcap: play from this time after the bag's first message"),
+        Param::real("duration_s", "0").min(0).unit("s").help("mcap: play this long (0 = to the end)"),
         Param::path("calibration", "")
             .help("OpenCV FileStorage YAML calibration that replaces the one the layout provides"),
         Param::boolean("loop", false).help("start again from the first frame after the last one"),
@@ -74,178 +84,47 @@ struct Settings {
     int64_t firstFrame = 0, maxFrames = 0;
     bool gray = false;
     double rateHz = 0.0;
+    McapSettings bag;
 };
 
 std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
 
-// Settings absent from `p` keep their defaults: a host may pass only what the YAML set.
+// The table above is the one home of each setting's default, bounds and choices: the
+// SDK's checker reads `p` against it (a setting the host did not pass is its default).
+// Only the rules it cannot state are written here.
 Settings readSettings(const sdk::Params &p) {
+    const sdk::CheckedParams c(p, parameterTable(), "replay");
     Settings s;
-    auto text = [&](const char *name, std::string &out) {
-        if (p.has(name)) out = p.string(name);
-    };
     // An unset PATH is empty whatever the host made of the empty default.
     auto path = [&](const char *name, std::string &out) {
-        if (p.has(name) && p.isExplicit(name)) out = p.string(name);
+        if (c.isExplicit(name)) out = c.string(name);
     };
-    text("layout", s.layout);
+    s.layout = c.string("layout");
     path("left", s.left);
     path("right", s.right);
     path("ground_truth", s.groundTruth);
     path("folder", s.folder);
     path("calibration", s.calibration);
-    if (p.has("ground_truth_scale")) s.groundTruthScale = p.real("ground_truth_scale");
-    if (p.has("loop")) s.loop = p.boolean("loop");
-    if (p.has("first_frame")) s.firstFrame = p.integer("first_frame");
-    if (p.has("max_frames")) s.maxFrames = p.integer("max_frames");
-    std::string color = "bgr";
-    text("color", color);
-    if (p.has("rate_hz")) s.rateHz = p.real("rate_hz");
-
-    auto refuse = [](const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what); };
-    const std::string layouts = "|auto|glob|middlebury|kitti|recording|";
-    if (s.layout.empty() || layouts.find("|" + s.layout + "|") == std::string::npos)
-        refuse("layout '" + s.layout + "': expected one of auto, glob, middlebury, kitti, recording");
-    if (color != "gray" && color != "bgr") refuse("color '" + color + "': expected gray or bgr");
-    s.gray = color == "gray";
-    if (!(s.groundTruthScale > 0) || !std::isfinite(s.groundTruthScale))
-        refuse("ground_truth_scale " + std::to_string(s.groundTruthScale) + ": expected a number > 0");
-    if (s.firstFrame < 0) refuse("first_frame " + std::to_string(s.firstFrame) + ": expected >= 0");
-    if (s.maxFrames < 0) refuse("max_frames " + std::to_string(s.maxFrames) + ": expected >= 0 (0 = all)");
+    s.groundTruthScale = c.real("ground_truth_scale");
+    s.loop = c.boolean("loop");
+    s.firstFrame = c.integer("first_frame");
+    s.maxFrames = c.integer("max_frames");
+    s.gray = c.string("color") == "gray";
+    s.rateHz = c.real("rate_hz");
+    path("bag", s.bag.bag);
+    if (c.isExplicit("left_topic")) s.bag.leftTopic = c.string("left_topic");
+    if (c.isExplicit("right_topic")) s.bag.rightTopic = c.string("right_topic");
+    s.bag.pairToleranceMs = c.real("pair_tolerance_ms");
+    s.bag.startS = c.real("start_s");
+    s.bag.durationS = c.real("duration_s");
+    if (!(s.groundTruthScale > 0))
+        c.refuse("ground_truth_scale", sdk::settingNumberText(s.groundTruthScale), "a number > 0");
     // Below 1 mHz the frame period (ns) would not fit 64 bits.
-    if (!(s.rateHz >= 0) || !std::isfinite(s.rateHz) || (s.rateHz > 0 && s.rateHz < 1e-3))
-        refuse("rate_hz " + std::to_string(s.rateHz) + ": expected 0 (as fast as possible) or a rate >= 0.001 Hz");
+    if (s.rateHz > 0 && s.rateHz < 1e-3)
+        c.refuse("rate_hz", sdk::settingNumberText(s.rateHz), "0 (as fast as possible) or a rate >= 0.001 Hz");
     return s;
 }
 
-// ---- What a layout yields ----------------------------------------------------------------
-
-// One stereo pair on disk.
-struct FrameFiles {
-    fs::path left, right;
-    fs::path groundTruth; // empty: no ground truth for this pair
-    bool hasTimestamps = false;
-    int64_t timestampLeftNs = 0, timestampRightNs = 0;
-    // Layout-specific facts for the frame's metadata ("ndisp", "recorded_sequence" ...).
-    std::vector<std::pair<std::string, std::string>> facts;
-};
-
-struct Plan {
-    std::string layout;
-    std::vector<FrameFiles> frames;
-    std::string calibration; // FileStorage YAML text; empty when unknown
-    // Recording: the last frame may have been cut short; if it cannot be decoded the
-    // stream ends before it, with a warning, instead of failing.
-    bool lenientLastFrame = false;
-    size_t droppedAtEnd = 0; // frames of a cut recording left out
-};
-
-// A rectified pinhole pair: the calibration the Middlebury and KITTI layouts know.
-struct PinholePair {
-    cv::Size imageSize;
-    cv::Matx33d M1, M2; // intrinsics; M2 keeps its own cx (Middlebury doffs)
-    double baselineMm = 0;
-
-    double focalLengthPx() const { return M1(0, 0); }
-
-    // The format of framework/core/calibration.hpp, rectification included, so that a
-    // reader needs not recompute it (which would equalise cx and lose doffs).
-    std::string toYaml() const {
-        const double f = M1(0, 0), cx0 = M1(0, 2), cy = M1(1, 2), cx1 = M2(0, 2);
-        cv::Mat P1 = (cv::Mat_<double>(3, 4) << f, 0, cx0, 0, 0, M1(1, 1), cy, 0, 0, 0, 1, 0);
-        cv::Mat P2 = (cv::Mat_<double>(3, 4) << M2(0, 0), 0, cx1, -M2(0, 0) * baselineMm, 0, M2(1, 1), M2(1, 2), 0, 0,
-                      0, 1, 0);
-        // OpenCV's Q for Tx = -B: W = (d + cx1 - cx0) / B, so Z = f B / (d + doffs).
-        cv::Mat Q = (cv::Mat_<double>(4, 4) << 1, 0, 0, -cx0, 0, 1, 0, -cy, 0, 0, 0, f, 0, 0, 1.0 / baselineMm,
-                     (cx1 - cx0) / baselineMm);
-        cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-        fs << "image_width" << imageSize.width << "image_height" << imageSize.height;
-        fs << "M1" << cv::Mat(M1) << "D1" << cv::Mat::zeros(1, 5, CV_64F);
-        fs << "M2" << cv::Mat(M2) << "D2" << cv::Mat::zeros(1, 5, CV_64F);
-        fs << "R" << cv::Mat::eye(3, 3, CV_64F) << "T" << (cv::Mat_<double>(3, 1) << -baselineMm, 0, 0);
-        fs << "rectified" << 1;
-        fs << "R1" << cv::Mat::eye(3, 3, CV_64F) << "R2" << cv::Mat::eye(3, 3, CV_64F);
-        fs << "P1" << P1 << "P2" << P2 << "Q" << Q;
-        fs << "baseline_mm" << baselineMm << "focal_length_px" << f;
-        return fs.releaseAndGetString();
-    }
-
-    void addFacts(FrameFiles &frame) const {
-        std::ostringstream f, b;
-        f.precision(10);
-        b.precision(10);
-        f << focalLengthPx();
-        b << baselineMm;
-        frame.facts.emplace_back("focal_length_px", f.str());
-        frame.facts.emplace_back("baseline_mm", b.str());
-    }
-
-    bool sameAs(const PinholePair &o) const {
-        auto close = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(a)); };
-        return imageSize == o.imageSize && close(focalLengthPx(), o.focalLengthPx()) &&
-               close(baselineMm, o.baselineMm) && close(M1(0, 2), o.M1(0, 2)) && close(M2(0, 2), o.M2(0, 2)) &&
-               close(M1(1, 2), o.M1(1, 2));
-    }
-};
-
-// Several scenes may come with several calibrations: the first one is published, each
-// frame's metadata carries its own focal length and baseline, and a difference is said.
-std::string publishFirst(const std::vector<std::pair<fs::path, PinholePair>> &calibrations, const sdk::Host &host) {
-    if (calibrations.empty()) return {};
-    for (const auto &c : calibrations)
-        if (!c.second.sameAs(calibrations.front().second)) {
-            host.warning("replay: calibrations differ between frames (" + inQuotes(calibrations.front().first) + " vs " +
-                         inQuotes(c.first) + "); the first one is published, each frame's metadata carries its own " +
-                         "focal_length_px and baseline_mm");
-            break;
-        }
-    return calibrations.front().second.toYaml();
-}
-
-// Metadata files are small; a folder or a huge file given in their place is refused
-// here rather than read (std::ifstream on a folder throws "basic_filebuf::underflow").
-constexpr uintmax_t kMaxMetadataBytes = uintmax_t{16} << 20;
-
-std::string readText(const fs::path &path, const std::string &what) {
-    std::error_code ec;
-    const auto status = fs::status(path, ec);
-    if (ec || !fs::exists(status)) throw Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read " + what + " " + inQuotes(path) + ": no such file");
-    if (!fs::is_regular_file(status))
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " is not a regular file");
-    const uintmax_t size = fs::file_size(path, ec);
-    if (ec || size > kMaxMetadataBytes)
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " holds " +
-                                                      std::to_string(size) + " bytes; expected at most " +
-                                                      std::to_string(kMaxMetadataBytes));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(BINOCLE_ERR_IO, "replay: cannot read " + what + " " + inQuotes(path) + ": " + std::strerror(errno));
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-// An image file's size from its header when the format is one input::inspectImage
-// reads, else from decoding it.
-cv::Size imageSizeOf(const fs::path &path) {
-    try {
-        const auto bytes = input::readImageFileBytes(path.string(), "image");
-        input::ImageInfo info;
-        std::string problem;
-        if (!input::inspectImage(bytes.data(), bytes.size(), info, problem))
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: image " + inQuotes(path) + ": " + problem);
-        if (!info.format.empty()) return cv::Size(static_cast<int>(info.width), static_cast<int>(info.height));
-        return input::readImage(path.string(), cv::IMREAD_UNCHANGED).size();
-    } catch (const input::ImageFileError &e) {
-        throw Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
-    }
-}
-
-bool isImageFile(const fs::path &p) {
-    std::string ext = p.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    static const std::vector<std::string> known{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".pfm", ".webp"};
-    return std::find(known.begin(), known.end(), ext) != known.end();
-}
 
 // ---- glob layout ---------------------------------------------------------------------------
 
@@ -525,10 +404,20 @@ Plan planRecording(const Settings &s, const sdk::Host &host) {
     return plan;
 }
 
+// ---- mcap layout -----------------------------------------------------------------------------
+// A rosbag2 MCAP bag (`bag`, or a `folder` holding one): see replay_mcap.hpp.
+
+Plan planMcap(const Settings &s, const sdk::Host &host) {
+    McapSettings m = s.bag;
+    if (m.bag.empty()) m.bag = s.folder;
+    return planBag(m, !s.calibration.empty(), host);
+}
+
 // ---- Layout detection --------------------------------------------------------------------------
 
 std::string detectLayout(const Settings &s) {
     if (!s.left.empty() || !s.right.empty()) return "glob";
+    if (!s.bag.bag.empty()) return "mcap";
     if (s.folder.empty())
         throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                     "replay: nothing to replay: set `left` and `right` (glob patterns) or `folder` (a Middlebury, KITTI "
@@ -539,6 +428,7 @@ std::string detectLayout(const Settings &s) {
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) + " does not exist or is not a folder");
     KittiCameras cams;
     if (fs::is_regular_file(folder / recording::kIndexFile)) return "recording";
+    if (isMcapBag(folder.string())) return "mcap";
     if (isMiddleburyScene(folder)) return "middlebury";
     if (kittiCameras(folder, cams)) return "kitti";
     for (const fs::path &sub : listFolder(folder, true))
@@ -546,14 +436,16 @@ std::string detectLayout(const Settings &s) {
     throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                 "replay: folder " + inQuotes(folder) +
                     " holds none of the known layouts: frames.csv (recording), im0.png and im1.png (middlebury, also "
-                    "in sub-folders), image_2/ and image_3/ (kitti); set `layout` or use `left`/`right` patterns");
+                    "in sub-folders), image_2/ and image_3/ (kitti), metadata.yaml or *.mcap (mcap); set `layout` "
+                    "or use `left`/`right` patterns");
 }
 
 Plan makePlan(const Settings &s, const sdk::Host &host) {
     const std::string layout = s.layout == "auto" ? detectLayout(s) : s.layout;
     const bool usesFolder = layout != "glob";
-    if (usesFolder && s.folder.empty())
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: layout " + layout + " needs `folder`");
+    if (usesFolder && s.folder.empty() && !(layout == "mcap" && !s.bag.bag.empty()))
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: layout " + layout + " needs `folder`" +
+                                                      (layout == "mcap" ? std::string(" or `bag`") : std::string()));
     if (usesFolder && (!s.left.empty() || !s.right.empty() || !s.groundTruth.empty()))
         host.warning("replay: `left`, `right` and `ground_truth` are ignored by layout " + layout);
     if (!usesFolder && !s.folder.empty()) host.warning("replay: `folder` is ignored by layout glob");
@@ -561,6 +453,7 @@ Plan makePlan(const Settings &s, const sdk::Host &host) {
     Plan plan = layout == "glob"         ? planGlob(s)
                 : layout == "middlebury" ? planMiddlebury(s, host)
                 : layout == "kitti"      ? planKitti(s, host)
+                : layout == "mcap"       ? planMcap(s, host)
                                          : planRecording(s, host);
 
     if (!s.calibration.empty()) {
@@ -662,6 +555,12 @@ public:
         out << YAML::Key << "frames_per_pass" << YAML::Value << plan_.frames.size();
         out << YAML::Key << "passes_completed" << YAML::Value << pass_;
         out << YAML::Key << "frames_dropped_at_end" << YAML::Value << plan_.droppedAtEnd;
+        if (plan_.bag) {
+            out << YAML::Key << "left_topic" << YAML::Value << plan_.bag->leftTopic();
+            out << YAML::Key << "right_topic" << YAML::Value << plan_.bag->rightTopic();
+            out << YAML::Key << "unpaired_left" << YAML::Value << plan_.bag->unpaired(0);
+            out << YAML::Key << "unpaired_right" << YAML::Value << plan_.bag->unpaired(1);
+        }
         out << YAML::EndMap;
         return out.c_str();
     }
@@ -670,6 +569,15 @@ private:
     // Decodes the pair and its ground truth; false when the frame was the cut-short end
     // of a recording and has been dropped.
     bool decode(const FrameFiles &files, Pixels &px) {
+        if (plan_.bag) {
+            plan_.bag->decode(static_cast<size_t>(files.bagPair), settings_.gray, px.left, px.right);
+            if (px.left.size() != px.right.size())
+                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: bag " + plan_.bag->files() + ": pair at stamp " +
+                                                              std::to_string(files.timestampLeftNs) + " ns: left image is " +
+                                                              sizeText(px.left) + " but right is " + sizeText(px.right) +
+                                                              "; a pair must have one size");
+            return true;
+        }
         // Pixels as stored: the calibration speaks of the sensor's rows, whatever EXIF says.
         const int flags = (settings_.gray ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR) | cv::IMREAD_IGNORE_ORIENTATION;
         // Headers are checked before decoding, and a cut-short file is refused rather
@@ -735,8 +643,12 @@ private:
         YAML::Emitter out;
         out << YAML::BeginMap;
         out << YAML::Key << "frame_index" << YAML::Value << next_ + static_cast<size_t>(settings_.firstFrame);
-        out << YAML::Key << "left_file" << YAML::Value << files.left.string();
-        out << YAML::Key << "right_file" << YAML::Value << files.right.string();
+        if (plan_.bag) {
+            out << YAML::Key << "bag" << YAML::Value << plan_.bag->files();
+        } else {
+            out << YAML::Key << "left_file" << YAML::Value << files.left.string();
+            out << YAML::Key << "right_file" << YAML::Value << files.right.string();
+        }
         if (!files.groundTruth.empty())
             out << YAML::Key << "ground_truth_file" << YAML::Value << files.groundTruth.string();
         for (const auto &[key, value] : files.facts) out << YAML::Key << key << YAML::Value << value;

@@ -13,7 +13,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <cerrno>
 #include <fstream>
+#include <sstream>
 #include <limits>
 #include <system_error>
 
@@ -212,6 +214,55 @@ GroundTruth readGroundTruth(const fs::path &path, double scale) {
     }
     gt.disparity.setTo(-1.0f, ~gt.valid);
     return gt;
+}
+
+namespace {
+std::string inQuotes(const std::filesystem::path &p) { return "'" + p.string() + "'"; }
+} // namespace
+
+// Metadata files are small; a folder or a huge file given in their place is refused
+// here rather than read (std::ifstream on a folder throws "basic_filebuf::underflow").
+constexpr uintmax_t kMaxMetadataBytes = uintmax_t{16} << 20;
+
+std::string readText(const std::filesystem::path &path, const std::string &what) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status)) throw sdk::Error(BINOCLE_ERR_NOT_FOUND, "replay: cannot read " + what + " " + inQuotes(path) + ": no such file");
+    if (!std::filesystem::is_regular_file(status))
+        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " is not a regular file");
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || size > kMaxMetadataBytes)
+        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + what + " " + inQuotes(path) + " holds " +
+                                                      std::to_string(size) + " bytes; expected at most " +
+                                                      std::to_string(kMaxMetadataBytes));
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw sdk::Error(BINOCLE_ERR_IO, "replay: cannot read " + what + " " + inQuotes(path) + ": " + std::strerror(errno));
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// An image file's size from its header when the format is one input::inspectImage
+// reads, else from decoding it.
+cv::Size imageSizeOf(const std::filesystem::path &path) {
+    try {
+        const auto bytes = input::readImageFileBytes(path.string(), "image");
+        input::ImageInfo info;
+        std::string problem;
+        if (!input::inspectImage(bytes.data(), bytes.size(), info, problem))
+            throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: image " + inQuotes(path) + ": " + problem);
+        if (!info.format.empty()) return cv::Size(static_cast<int>(info.width), static_cast<int>(info.height));
+        return input::readImage(path.string(), cv::IMREAD_UNCHANGED).size();
+    } catch (const input::ImageFileError &e) {
+        throw sdk::Error(e.notFound() ? BINOCLE_ERR_NOT_FOUND : BINOCLE_ERR_IO, std::string("replay: ") + e.what());
+    }
+}
+
+bool isImageFile(const std::filesystem::path &p) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    static const std::vector<std::string> known{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".pfm", ".webp"};
+    return std::find(known.begin(), known.end(), ext) != known.end();
 }
 
 } // namespace binocle::replay

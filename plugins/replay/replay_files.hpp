@@ -44,4 +44,12 @@ struct GroundTruth {
 };
 GroundTruth readGroundTruth(const std::filesystem::path &path, double scale);
 
+// The text of a small metadata file (at most 16 MiB); a folder, a missing or a larger file is
+// refused (sdk::Error naming `what` and the path).
+std::string readText(const std::filesystem::path &path, const std::string &what);
+// An image file's size from its header (input::inspectImage), else from decoding it.
+cv::Size imageSizeOf(const std::filesystem::path &path);
+// By its extension: png, jpg, jpeg, bmp, tif, tiff, pgm, ppm, pfm, webp.
+bool isImageFile(const std::filesystem::path &p);
+
 } // namespace binocle::replay

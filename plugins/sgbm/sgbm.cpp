@@ -30,7 +30,7 @@ public:
                 .help("penalty for a disparity change of more than 1 px, > p1; unset or 0 = 32 * block_size^2"),
             Param::choice("mode", "sgbm", "sgbm|hh|sgbm_3way|hh4")
                 .help("5 paths (sgbm), 8 paths (hh, much more memory), 3-way (sgbm_3way, faster) or 4 paths (hh4)"),
-            Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
+            Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB").limit()
                 .help("refuse a pair whose working buffers cv::StereoSGBM would need more than this (estimated before matching)"),
         });
     }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sgm: the matching of one pair: census of both images, then per stripe of rows the
-// costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over a
-// volume of 16-bit sums), winner takes all with the left-right check, then a median.
+// costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over
+// volumes the pass down kept), winner takes all with the left-right check, then a median.
 #include "sgm_engine.hpp"
 
 #include <algorithm>
@@ -21,6 +21,10 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
     // 5 paths: left, right and the three from above, all in one pass down (no volume).
     // 4 and 8: the pass down keeps its sums in a volume, the pass up adds the paths from below.
     twoPass_ = settings_.paths != 5;
+    // 4: the pass down keeps only its costs and its 8-bit vertical path (2 bytes per
+    // disparity instead of 3, and nothing written back by the pass up); the pass up runs
+    // the horizontal paths and sums all four in a row that stays in cache.
+    keepDownPath_ = settings_.paths == 4;
     if (settings_.paths == 4) downDx_ = upDx_ = {0};
     else if (settings_.paths == 5) downDx_ = {-1, 0, 1};
     else downDx_ = upDx_ = {-1, 0, 1};
@@ -37,7 +41,8 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
 double Engine::workingBytes(int width, int height) const {
     const double w = width, h = height, dp = paddedDisp_, ds = pathStride(paddedDisp_);
     const double rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
-    const double volume = twoPass_ ? w * h * dp * 3 : 0; // 16-bit sums and 8-bit costs
+    // 8-bit costs, and the 16-bit sums (8 paths) or the 8-bit vertical path (4 paths).
+    const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
     const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 2 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
@@ -52,7 +57,9 @@ void Engine::prepare(int width, int height) {
             "sgm: paths " + std::to_string(settings_.paths) + " on a " + std::to_string(width) + "x" +
             std::to_string(height) + " pair with num_disparities " + std::to_string(settings_.numDisparities) +
             " needs about " + mebibytes(need) + " MiB of working memory" +
-            (twoPass_ ? " (volumes of width x height x num_disparities costs and sums: 3 bytes each)" : "") +
+            (keepDownPath_ ? " (volumes of width x height x num_disparities costs and path costs: 2 bytes each)"
+             : twoPass_    ? " (volumes of width x height x num_disparities costs and sums: 3 bytes each)"
+                           : "") +
             "; expected at most max_memory_mb = " + mebibytes(settings_.maxMemoryBytes) + ": use " +
             (twoPass_ ? "paths 5 (no volume), " : "") + "fewer disparities, smaller images or raise max_memory_mb");
     width_ = width;
@@ -61,7 +68,9 @@ void Engine::prepare(int width, int height) {
     const size_t ds = pathStride(paddedDisp_);
     censusLeft_.assign(w * h, 0);
     censusRight_.assign(w * h, 0);
-    volume_.assign(twoPass_ ? w * h * dp : 0, 0);
+    volume_.assign(twoPass_ && !keepDownPath_ ? w * h * dp : 0, 0);
+    // The sentinels at d = -1 and d = Dp of every pixel are written here, once.
+    downPath_.assign(keepDownPath_ ? w * h * ds : 0, kCostInvalid);
     costVolume_.assign(twoPass_ ? w * h * dp : 0, 0);
     stripes_.assign(static_cast<size_t>(std::clamp(settings_.stripes, 1, height)), Stripe{});
     for (Stripe &s : stripes_) {
@@ -149,30 +158,43 @@ void Engine::matchStripe(int index, int y0, int y1) {
     auto pathL = [&](size_t dir, int parity) { return rowsL + (2 * dir + parity) * w * ds; };
     auto pathMin = [&](size_t dir, int parity) { return mins + (2 * dir + parity) * w; };
 
+    const uint8_t *prevRowL[kMaxRowPaths] = {};
     auto run = [&](const std::vector<int> &dxs, int yFirst, int yLast, int step, bool down) {
         int parity = 0;
         for (int y = yFirst;; y += step) {
             const bool own = y >= y0 && y < y1;
             const uint8_t *cost = costRow(s, y, own, down);
-            uint16_t *sum = own && twoPass_ ? volumeRow(y) : s.scratchSum.data();
-            bool init = !own || down; // the pass up adds to the pass down's sums
-            if (own && down) {
-                kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
-                                       s.horizontal.data(), sum, true);
-                init = false;
+            // Rows outside the stripe only carry their paths on: no sums.
+            uint16_t *sum = nullptr;
+            if (own && keepDownPath_) {
+                if (!down) { // the horizontal paths first, then this pass's and the kept vertical
+                    sum = s.scratchSum.data();
+                    kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                                           s.horizontal.data(), sum, true);
+                }
+            } else if (own) {
+                // The pass down stores the horizontal paths' sums; the rest add to them (the
+                // pass up to the pass down's).
+                sum = twoPass_ ? volumeRow(y) : s.scratchSum.data();
+                if (down)
+                    kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                                           s.horizontal.data(), sum, true);
             }
             const bool first = y == yFirst;
+            const bool keep = keepDownPath_ && own && down;
             const uint8_t *greyPrev = first ? nullptr : greyLeft_.ptr<uint8_t>(y - step);
             RowPaths rp{};
             rp.count = static_cast<int>(dxs.size());
             for (size_t i = 0; i < dxs.size(); ++i) {
                 rp.dx[i] = dxs[i];
-                rp.prevL[i] = first ? nullptr : pathL(i, parity ^ 1);
+                rp.prevL[i] = first ? nullptr : prevRowL[i];
                 rp.prevMin[i] = pathMin(i, parity ^ 1);
-                rp.curL[i] = pathL(i, parity);
+                rp.curL[i] = keep ? downPathRow(y) : pathL(i, parity);
                 rp.curMin[i] = pathMin(i, parity);
+                prevRowL[i] = rp.curL[i];
             }
-            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, init);
+            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
+            if (own && keepDownPath_ && !down) kernels_.addPathRow(downPathRow(y), width_, paddedDisp_, sum);
             if (own && (down != twoPass_)) finishRow(s, sum, y);
             parity ^= 1;
             if (y == yLast) break;

@@ -67,16 +67,21 @@ private:
     const uint8_t *costRow(Stripe &s, int y, bool own, bool down);
     void finishRow(Stripe &s, const uint16_t *sum, int y);
     uint16_t *volumeRow(int y) { return volume_.data() + static_cast<size_t>(y) * width_ * paddedDisp_; }
+    uint8_t *downPathRow(int y) {
+        return downPath_.data() + static_cast<size_t>(y) * width_ * pathStride(paddedDisp_);
+    }
 
     Settings settings_;
     const Kernels &kernels_;
     int width_ = 0, height_ = 0, paddedDisp_ = 0;
     bool twoPass_ = true;
+    bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2Lut_[256];
     cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_, filtered_;
     std::vector<uint64_t> censusLeft_, censusRight_;
-    std::vector<uint16_t> volume_;  // 4 and 8 paths: the pass down's sums
+    std::vector<uint16_t> volume_;  // 8 paths: the pass down's sums
+    std::vector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
     std::vector<uint8_t> costVolume_; // and its costs, which the pass up reads again
     std::vector<Stripe> stripes_;
     int allocations_ = 0;

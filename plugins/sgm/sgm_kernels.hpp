@@ -56,7 +56,8 @@ struct PathParams {
 // x + dx[i] of prevL[i] (dx in -1, 0, 1); a pixel without predecessor (prevL[i] NULL, or
 // x + dx[i] outside) starts the path. grey/greyPrev: the intensities of this row and of
 // the previous one, for the penalty P2. Writes curL[i] and curMin[i], and adds the
-// row's path costs to sum (or stores them when initSum).
+// row's path costs to sum (or stores them when initSum); sum NULL: no sum (a row whose
+// paths are only carried on, or kept whole for a later pass).
 constexpr int kMaxRowPaths = 3;
 struct RowPaths {
     int count;
@@ -73,6 +74,10 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
 // stored, when initSum); scratch: 2 * pathStride(paddedDisp) bytes.
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
+
+// Adds one stored path row (the path-row layout above) to a row of sums: the pass up of
+// 4 paths adds the pass down's vertical path, kept as 8-bit costs.
+using AddPathRowFn = void (*)(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum);
 
 // Winner takes all over one row of sums, d in [0, numDisp). For every pixel:
 // best[x] = the lowest d of least sum (-1 where no candidate lies inside the right
@@ -97,6 +102,7 @@ struct Kernels {
     CostRowFn costRow;
     PathRowFn pathRow;
     HorizontalRowFn horizontalRow;
+    AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
 };
 

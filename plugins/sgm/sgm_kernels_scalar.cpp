@@ -53,7 +53,7 @@ uint8_t pathStep(const uint8_t *cost, const uint8_t *prev, int minPrev, int p1, 
         const uint8_t l = addSat(cost[d], subSat(t, minPrev));
         out[d] = l;
         least = std::min(least, l);
-        sum[d] = static_cast<uint16_t>(initSum ? l : std::min(65535, sum[d] + l));
+        if (sum) sum[d] = static_cast<uint16_t>(initSum ? l : std::min(65535, sum[d] + l));
     }
     return least;
 }
@@ -80,7 +80,8 @@ void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPath
             const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
             paths.curMin[i][x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2,
                                           paths.curL[i] + static_cast<size_t>(x) * stride + 1,
-                                          sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum && i == 0);
+                                          sum ? sum + static_cast<size_t>(x) * paddedDisp : nullptr, paddedDisp,
+                                          initSum && i == 0);
         }
 }
 
@@ -105,6 +106,15 @@ void horizontalRowScalar(const uint8_t *cost, int width, int paddedDisp, const u
                          uint8_t *scratch, uint16_t *sum, bool initSum) {
     horizontalPath(cost, width, paddedDisp, false, grey, pp, scratch, sum, initSum);
     horizontalPath(cost, width, paddedDisp, true, grey, pp, scratch, sum, false);
+}
+
+void addPathRowScalar(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
+    const int stride = pathStride(paddedDisp);
+    for (int x = 0; x < width; ++x)
+        for (int d = 0; d < paddedDisp; ++d) {
+            uint16_t &s = sum[static_cast<size_t>(x) * paddedDisp + d];
+            s = static_cast<uint16_t>(std::min(65535, s + pathRow[static_cast<size_t>(x) * stride + 1 + d]));
+        }
 }
 
 void wtaRowScalar(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
@@ -132,7 +142,7 @@ void wtaRowScalar(const uint16_t *sum, int width, const WtaParams &wp, int16_t *
 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", censusRowScalar, costScratchScalar, costRowScalar,
-                           pathRowScalar, horizontalRowScalar, wtaRowScalar};
+                           pathRowScalar, horizontalRowScalar, addPathRowScalar, wtaRowScalar};
     return k;
 }
 

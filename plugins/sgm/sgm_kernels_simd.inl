@@ -165,6 +165,20 @@ void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pat
             out[i] = paths.curL[i] + static_cast<size_t>(x) * stride + 1;
         }
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        if (!sum) { // the costs only: no sums to read or write
+            for (int d = 0; d < paddedDisp; d += kLanes8) {
+                const v_uint8 c = vx_load(c0 + d);
+                for (int i = 0; i < n; ++i) {
+                    const uint8_t *q = prev[i] + d;
+                    const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+                    const v_uint8 l = c + (v_min(v_min(vx_load(q), steps), jump[i]) - base[i]);
+                    v_store(out[i] + d, l);
+                    least[i] = v_min(least[i], l);
+                }
+            }
+            for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+            continue;
+        }
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         for (int d = 0; d < paddedDisp; d += kLanes8) {
             const v_uint8 c = vx_load(c0 + d);
@@ -250,6 +264,20 @@ void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t
     }
 }
 
+void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
+    const int stride = pathStride(paddedDisp);
+    for (int x = 0; x < width; ++x) {
+        const uint8_t *l0 = pathRow + static_cast<size_t>(x) * stride + 1;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            v_uint16 lo, hi;
+            v_expand(vx_load(l0 + d), lo, hi);
+            v_store(s0 + d, vx_load(s0 + d) + lo);
+            v_store(s0 + d + kLanes16, vx_load(s0 + d + kLanes16) + hi);
+        }
+    }
+}
+
 // ---- winner takes all -----------------------------------------------------------------
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
             uint16_t *disparity16) {
@@ -293,7 +321,7 @@ void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, 
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, wtaRow};
+    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, addPathRow, wtaRow};
     return k;
 }
 

@@ -8,6 +8,8 @@
 
 #include <linux/videodev2.h>
 
+#include <binocle/settings.hpp>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -47,7 +49,7 @@ std::vector<binocle_param_desc> V4l2Source::parameters() {
             .help("frame rate asked of each device (VIDIOC_S_PARM); 0 keeps the driver's"),
         Param::integer("buffer_count", "4").min(2).max(32)
             .help("memory-mapped buffers per device (VIDIOC_REQBUFS)"),
-        Param::real("pair_tolerance_ms", "0").min(0).unit("ms")
+        Param::real("pair_tolerance_ms", "0").min(0).max(1e6).unit("ms")
             .help("two_devices: largest time-stamp difference within a pair; 0 = half the frame period"),
     };
 }
@@ -64,54 +66,35 @@ std::string number(double v) {
     return s.str();
 }
 
-// Settings absent from `p` keep their defaults: a host may pass only what the YAML set.
+// The table above is the one home of each setting's default, bounds and choices: the
+// SDK's checker reads `p` against it (a setting the host did not pass is its default).
+// Only the rules across settings are written here.
 Settings readSettings(const sdk::Params &p) {
+    const sdk::CheckedParams c(p, V4l2Source::parameters(), "v4l2");
     Settings s;
-    auto refuse = [](const std::string &key, const std::string &value, const std::string &expected) {
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "v4l2: " + key + " = " + value + ": expected " + expected);
-    };
-    auto text = [&](const char *key, const std::string &def) { return p.has(key) ? p.string(key) : def; };
-    auto integer = [&](const char *key, int64_t def, int64_t lo, int64_t hi) {
-        const int64_t v = p.has(key) ? p.integer(key) : def;
-        if (v < lo || v > hi) refuse(key, std::to_string(v), "an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
-        return v;
-    };
-    auto real = [&](const char *key, double def, double hi) {
-        const double v = p.has(key) ? p.real(key) : def;
-        if (!std::isfinite(v) || v < 0 || v > hi) refuse(key, number(v), "a number from 0 to " + number(hi));
-        return v;
-    };
+    s.sideBySide = c.string("layout") == "side_by_side";
+    s.deviceLeft = c.string("device_left");
+    s.deviceRight = c.string("device_right");
+    s.swapHalves = c.boolean("swap_halves");
+    const std::string &format = c.string("pixel_format");
+    s.fourcc = format == "grey" ? V4L2_PIX_FMT_GREY : format == "mjpeg" ? V4L2_PIX_FMT_MJPEG : V4L2_PIX_FMT_YUYV;
+    s.bgr = c.string("color") == "bgr";
+    s.width = static_cast<uint32_t>(c.integer("width"));
+    s.height = static_cast<uint32_t>(c.integer("height"));
+    s.fps = c.real("fps");
+    s.bufferCount = static_cast<uint32_t>(c.integer("buffer_count"));
+    s.pairToleranceMs = c.real("pair_tolerance_ms");
 
-    const std::string layout = text("layout", "two_devices");
-    if (layout != "two_devices" && layout != "side_by_side") refuse("layout", "'" + layout + "'", "two_devices or side_by_side");
-    s.sideBySide = layout == "side_by_side";
-    s.deviceLeft = text("device_left", s.deviceLeft);
-    s.deviceRight = text("device_right", s.deviceRight);
-    s.swapHalves = p.has("swap_halves") && p.boolean("swap_halves");
-    const std::string format = text("pixel_format", "yuyv");
-    if (format == "grey") s.fourcc = V4L2_PIX_FMT_GREY;
-    else if (format == "yuyv") s.fourcc = V4L2_PIX_FMT_YUYV;
-    else if (format == "mjpeg") s.fourcc = V4L2_PIX_FMT_MJPEG;
-    else refuse("pixel_format", "'" + format + "'", "grey, yuyv or mjpeg");
-    const std::string color = text("color", "gray");
-    if (color != "gray" && color != "bgr") refuse("color", "'" + color + "'", "gray or bgr");
-    s.bgr = color == "bgr";
-    s.width = static_cast<uint32_t>(integer("width", 640, 2, 16384));
-    s.height = static_cast<uint32_t>(integer("height", 480, 1, 16384));
-    s.fps = real("fps", 30, 1000);
-    s.bufferCount = static_cast<uint32_t>(integer("buffer_count", 4, 2, 32));
-    s.pairToleranceMs = real("pair_tolerance_ms", 0, 1e6);
-
-    if (s.deviceLeft.empty()) refuse("device_left", "''", "a device path such as /dev/video0");
+    if (s.deviceLeft.empty()) c.refuse("device_left", "''", "a device path such as /dev/video0");
     if (s.sideBySide) {
         if (s.width % 2 != 0)
-            refuse("width", std::to_string(s.width), "an even width with layout side_by_side (two halves of width/2)");
+            c.refuse("width", std::to_string(s.width), "an even width with layout side_by_side (two halves of width/2)");
     } else {
-        if (s.deviceRight.empty()) refuse("device_right", "''", "a device path such as /dev/video1");
+        if (s.deviceRight.empty()) c.refuse("device_right", "''", "a device path such as /dev/video1");
         if (s.deviceRight == s.deviceLeft)
-            refuse("device_right", s.deviceRight,
-                   "another device than device_left with layout two_devices (one device delivering both images is "
-                   "layout side_by_side)");
+            c.refuse("device_right", s.deviceRight,
+                     "another device than device_left with layout two_devices (one device delivering both images is "
+                     "layout side_by_side)");
     }
     return s;
 }

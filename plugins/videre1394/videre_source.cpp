@@ -9,6 +9,7 @@
 
 #include "svs_calibration.hpp"
 
+#include <binocle/settings.hpp>
 #include <dc1394/conversions.h>
 
 #include <opencv2/core.hpp>
@@ -73,33 +74,20 @@ std::string describe(const CameraInfo &c) {
 
 bool isVidere(const CameraInfo &c) { return lower(c.vendor).find("videre") != std::string::npos; }
 
-// Settings absent from `p` keep their defaults: a host may pass only what the YAML set.
+// The table above is the one home of each setting's default, bounds and choices: the
+// SDK's checker reads `p` against it (a setting the host did not pass is its default).
 Settings readSettings(const sdk::Params &p) {
+    const sdk::CheckedParams c(p, VidereSource::parameters(), "videre1394");
     Settings s;
-    auto refuse = [](const std::string &key, const std::string &value, const std::string &expected) {
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "videre1394: " + key + " = " + value + ": expected " + expected);
-    };
-    if (p.has("guid")) s.guid = p.string("guid");
-    if (p.has("video_mode")) s.videoMode = p.string("video_mode");
-    if (p.has("fps")) s.fps = p.real("fps");
-    if (p.has("decimation")) s.decimation = static_cast<int>(p.integer("decimation"));
-    if (p.has("left_byte")) {
-        const std::string b = p.string("left_byte");
-        if (b != "first" && b != "second") refuse("left_byte", "'" + b + "'", "first or second");
-        s.leftIsFirstByte = b == "first";
-    }
-    if (p.has("iso_speed_mbps")) {
-        const std::string v = p.string("iso_speed_mbps");
-        if (v != "100" && v != "200" && v != "400" && v != "800") refuse("iso_speed_mbps", v, "100, 200, 400 or 800");
-        s.isoSpeedMbps = static_cast<uint32_t>(std::stoul(v));
-    }
-    if (p.has("buffer_count")) s.bufferCount = static_cast<uint32_t>(p.integer("buffer_count"));
-    if (p.has("use_stored_calibration")) s.useStoredCalibration = p.boolean("use_stored_calibration");
-
-    if (!std::isfinite(s.fps) || s.fps < 0 || s.fps > 240) refuse("fps", number(s.fps), "a frame rate from 0 to 240");
-    if (s.decimation < 1 || s.decimation > 8) refuse("decimation", std::to_string(s.decimation), "an integer from 1 to 8");
-    if (s.bufferCount < 2 || s.bufferCount > 64) refuse("buffer_count", std::to_string(s.bufferCount), "2 to 64");
-    if (s.videoMode.empty()) refuse("video_mode", "''", "a mode such as 640x480_MONO16 or format7_0");
+    s.guid = c.string("guid");
+    s.videoMode = c.string("video_mode");
+    s.fps = c.real("fps");
+    s.decimation = static_cast<int>(c.integer("decimation"));
+    s.leftIsFirstByte = c.string("left_byte") == "first";
+    s.isoSpeedMbps = static_cast<uint32_t>(std::stoul(c.string("iso_speed_mbps"))); // one of its choices
+    s.bufferCount = static_cast<uint32_t>(c.integer("buffer_count"));
+    s.useStoredCalibration = c.boolean("use_stored_calibration");
+    if (s.videoMode.empty()) c.refuse("video_mode", "''", "a mode such as 640x480_MONO16 or format7_0");
     return s;
 }
 

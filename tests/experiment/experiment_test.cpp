@@ -85,8 +85,8 @@ TEST(Experiment, BindingAndSensorFiguresComeFromTheSettingsTables) {
     Experiment e1 = loadExperiment(BINOCLE_SOURCE_DIR "/configs/experiments/e1.yaml", host);
     EXPECT_EQ(e1.bind["range_mm"], std::vector<std::string>{"source.range_mm"});
     EXPECT_EQ(e1.bind["inclination_deg"], (std::vector<std::string>{"source.inclination_deg", "transforms.0.inclination_deg"}));
-    EXPECT_DOUBLE_EQ(e1.pixel_pitch_um, 20.8); // the simulated head's default pixel pitch
-    EXPECT_EQ(e1.image_width_px, 320);
+    EXPECT_DOUBLE_EQ(e1.head.pixel_pitch_um, 20.8); // the simulated head's default pixel pitch
+    EXPECT_EQ(e1.head.image_width_px, 320);
 
     // A source that cannot be re-posed (files): the variables are recorded, not applied,
     // and the experiment still runs.
@@ -396,6 +396,148 @@ TEST(Design, RanksWithThePredictorOfHighestRhoAndPrintsEachRho) {
     EXPECT_NE(r.output.find("unknown predictor 'magic'"), std::string::npos) << r.output;
     r = runCli("design --range 12000 --predictor nonsense");
     EXPECT_NE(r.output.find("--predictor nonsense: unknown"), std::string::npos) << r.output;
+}
+
+} // namespace
+
+// Outputs that never clobber or mix, and inputs whose size or meaning is refused up front
+// (issue 24).
+namespace {
+
+using binocle::test::runCommand;
+
+const std::string kFourTests = "  - {id: 1, range_mm: 6000, baseline_mm: 100, focal_length_mm: 8}\n"
+                               "  - {id: 2, range_mm: 6000, baseline_mm: 150, focal_length_mm: 8}\n"
+                               "  - {id: 3, range_mm: 6000, baseline_mm: 150, focal_length_mm: 12}\n"
+                               "  - {id: 4, range_mm: 12000, baseline_mm: 190, focal_length_mm: 12}\n";
+
+size_t csvRows(const std::string &file) {
+    const std::string csv = readTextFile(file);
+    return static_cast<size_t>(std::count(csv.begin(), csv.end(), '\n')) - 1;
+}
+
+TEST(ExperimentOutputs, AnInterruptedRerunLeavesNoOldChartsAndSaysItIsInterrupted) {
+    TempDir dir;
+    const std::string file = dir.str("four.yaml"), out = dir.str("out");
+    writeText(file, repeatText("frames: 3\n", kFourTests));
+    ASSERT_EQ(runCli("experiment " + file + " --quiet --out " + out).exit_code, 0);
+    EXPECT_EQ(readJson(out + "/results.json")["status"], "complete");
+    ASSERT_TRUE(std::filesystem::exists(out + "/eta_3d_bars.png"));
+    // The same experiment again, killed once its first test is in the table.
+    const auto killed = runCommand("BINOCLE_PLUGIN_PATH='" BINOCLE_BUILD_PLUGIN_DIR "' '" BINOCLE_CLI "' experiment " + file +
+                                   " --quiet --out " + out + " & pid=$!; for i in $(seq 1 6000); do grep -qs '\"status\": "
+                                   "\"interrupted\"' " + out + "/results.json && break; sleep 0.01; done; kill -9 $pid; wait $pid");
+    const OJson doc = readJson(out + "/results.json");
+    ASSERT_EQ(doc["status"], "interrupted") << killed.output;
+    ASSERT_LT(doc["tests"].size(), 4u);
+    EXPECT_EQ(csvRows(out + "/results.csv"), doc["tests"].size()); // the two tables agree
+    // Nothing of the earlier run stands beside the short table.
+    for (const char *chart : {"eta_3d_bars.png", "eta_2d_bars.svg", "eta_3d_vs_ff.png"})
+        EXPECT_FALSE(std::filesystem::exists(out + "/" + chart)) << chart;
+    EXPECT_FALSE(std::filesystem::exists(out + "/test_4"));
+    // The report says it is not the whole; a merge refuses it.
+    auto r = runCli("report " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("incomplete results: the run stopped after"), std::string::npos) << r.output;
+    EXPECT_NE(readTextFile(out + "/report.html").find("INCOMPLETE"), std::string::npos);
+    r = runCli("experiment merge " + dir.str("m") + " " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("holds an interrupted run"), std::string::npos) << r.output;
+}
+
+TEST(ExperimentOutputs, AnotherExperimentsResultsAreReplacedOnlyWithForceAndThenWhole) {
+    TempDir dir;
+    const std::string a = dir.str("a.yaml"), b = dir.str("b.yaml"), out = dir.str("out");
+    writeText(a, repeatText("", kFourTests));
+    writeText(b, repeatText("", "  - {id: x, range_mm: 6000, baseline_mm: 100, focal_length_mm: 4}\n"));
+    ASSERT_EQ(runCli("experiment " + a + " --quiet --out " + out).exit_code, 0);
+    const std::string before = readTextFile(out + "/results.csv");
+    auto r = runCli("experiment " + b + " --quiet --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("already holds the results of " + a + ", not of " + b), std::string::npos) << r.output;
+    EXPECT_EQ(readTextFile(out + "/results.csv"), before);
+    r = runCli("experiment " + b + " --quiet --force --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(csvRows(out + "/results.csv"), 1u);
+    EXPECT_TRUE(std::filesystem::exists(out + "/test_x"));
+    EXPECT_FALSE(std::filesystem::exists(out + "/test_1")); // a's folders went with a's table
+    // A merge into a folder holding results, the same way.
+    ASSERT_EQ(runCli("experiment " + a + " --quiet --shard 1/2 --out " + dir.str("s1")).exit_code, 0);
+    r = runCli("experiment merge " + out + " " + dir.str("s1"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find(out + " already holds results"), std::string::npos) << r.output;
+    r = runCli("experiment merge --force " + out + " " + dir.str("s1"));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out + "/test_x"));
+}
+
+TEST(ExperimentOutputs, MergeMarksAnIncompleteSetAndRefusesShardsOfAnEditedExperiment) {
+    TempDir dir;
+    const std::string file = dir.str("s.yaml");
+    writeText(file, repeatText("", kFourTests));
+    ASSERT_EQ(runCli("experiment " + file + " --quiet --shard 1/2 --out " + dir.str("s1")).exit_code, 0);
+    EXPECT_EQ(readJson(dir.str("s1/results.json"))["status"], "partial");
+    auto r = runCli("experiment merge " + dir.str("m") + " " + dir.str("s1"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("2 of 4 tests merged; missing: 2, 4"), std::string::npos) << r.output;
+    const OJson merged = readJson(dir.str("m/results.json"));
+    EXPECT_EQ(merged["status"], "partial");
+    EXPECT_EQ(merged["missing_tests"], OJson::array({"2", "4"}));
+    // The experiment edited after shard 1 ran: its rows no longer describe the file's tests.
+    std::string edited = repeatText("", kFourTests);
+    edited.replace(edited.find("baseline_mm: 100"), 16, "baseline_mm: 110");
+    writeText(file, edited);
+    r = runCli("experiment merge " + dir.str("m2") + " " + dir.str("s1"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("test 1 of " + dir.str("s1") + " was run with baseline_mm = 100; " + file + " now says 110"),
+              std::string::npos)
+        << r.output;
+    // The rig changed under it (rig_set here; an edited rig file the same).
+    writeText(file, repeatText("rig_set: {source: {noise_sigma: 3}}\n", kFourTests));
+    r = runCli("experiment merge " + dir.str("m3") + " " + dir.str("s1"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("was run on another rig than"), std::string::npos) << r.output;
+}
+
+TEST(ExperimentInputs, MistakesAreRefusedBeforeAnythingRunsOrIsWritten) {
+    TempDir dir;
+    const std::string file = dir.str("e.yaml"), out = dir.str("out");
+    writeText(file, repeatText("", kFourTests));
+    auto r = runCli("experiment " + file + " --quiet --tests 1,99 --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("--tests 1, 99: experiment " + file + " has no test '99' (its tests: 1, 2, 3, 4)"), std::string::npos)
+        << r.output;
+    r = runCli("experiment " + file + " --quiet --set repeats=3 --set 'seeds=[5, 5, 5]' --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("seeds: 5 is listed twice: each repeat needs its own seed"), std::string::npos) << r.output;
+    writeText(file, "name: ../../x\n" + repeatText("", kFourTests).substr(std::string("name: rep\n").size()));
+    r = runCli("experiment " + file + " --quiet --check");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("name '../../x': expected letters, digits"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(ExperimentInputs, YamlAliasesThatExpandPastTheBoundAreRefusedWithTheNumber) {
+    TempDir dir;
+    const std::string file = dir.str("bomb.yaml");
+    // Six levels of ten aliases: a million values from a few lines.
+    std::string bomb = "rig_set:\n  source:\n    l0: &l0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+    for (int level = 1; level <= 5; ++level) {
+        const std::string prev = "*l" + std::to_string(level - 1);
+        bomb += "    l" + std::to_string(level) + ": &l" + std::to_string(level) + " [";
+        for (int k = 0; k < 10; ++k) bomb += (k ? ", " : "") + prev;
+        bomb += "]\n";
+    }
+    writeText(file, repeatText(bomb, kFourTests));
+    auto r = runCli("experiment " + file + " --check");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("more than 100000 YAML nodes once its aliases are expanded"), std::string::npos) << r.output;
+}
+
+TEST(Design, ABaselineSweepIsCountedBeforeItIsMade) {
+    auto r = runCli("design --range 6000 --baselines 1:1e9:1");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("--baselines 1:1e9:1: 1000000000 baselines; at most 100000"), std::string::npos) << r.output;
 }
 
 } // namespace

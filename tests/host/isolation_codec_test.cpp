@@ -291,6 +291,11 @@ TEST(IsolationCodec, EvaluateRoundTripsAndKeepsTextsNotSentAgain) {
     in.calibration_yaml = "K: [1]";
     in.rig_yaml = nullptr;
     in.output_dir = "/tmp/out";
+    in.min_disparity = -3;
+    in.num_disparities = 96;
+    in.ground_pose_known = 1;
+    in.camera_height_mm = 1234.5;
+    in.inclination_deg = 7.25;
     wire::EvaluateTexts kept;
     for (bool send : {true, false}) {
         wire::Layout layout;
@@ -310,6 +315,11 @@ TEST(IsolationCodec, EvaluateRoundTripsAndKeepsTextsNotSentAgain) {
         EXPECT_STREQ(got.in.calibration_yaml, "K: [1]") << "sent: " << send; // kept from the first
         EXPECT_EQ(got.in.rig_yaml, nullptr);
         EXPECT_STREQ(got.in.output_dir, "/tmp/out");
+        EXPECT_EQ(got.in.min_disparity, -3);
+        EXPECT_EQ(got.in.num_disparities, 96);
+        EXPECT_EQ(got.in.ground_pose_known, 1);
+        EXPECT_EQ(got.in.camera_height_mm, 1234.5);
+        EXPECT_EQ(got.in.inclination_deg, 7.25);
         EXPECT_TRUE(r.atEnd());
     }
 }

@@ -52,6 +52,26 @@ TEST(Numbers, RealsAreDecimalAndFiniteUnlessAsked) {
     EXPECT_FALSE(fitsInt64(9223372036854775808.0));
 }
 
+// One rule for every number (issue 24, "numbers read two ways"): a leading zero or a
+// radix prefix is an error for integers and reals alike, with the reading it would get
+// elsewhere and the decimal to write.
+TEST(Numbers, LeadingZerosAndPrefixesAreErrorsForRealsToo) {
+    double v = 0;
+    std::string why;
+    EXPECT_FALSE(parseReal("010", v, &why));
+    EXPECT_EQ(why, "expected a decimal number without leading zeros (010 would read as octal 8 elsewhere: write 10)");
+    EXPECT_FALSE(parseReal("-00.5", v, &why));
+    EXPECT_NE(why.find("write -0.5"), std::string::npos) << why;
+    EXPECT_FALSE(parseReal("0x10", v, &why));
+    EXPECT_EQ(why, "expected a decimal number (0x10 is hexadecimal: write 16)");
+    for (const char *good : {"0", "0.5", "-0.5", "0e0", "10", "1e05"}) EXPECT_TRUE(parseReal(good, v)) << good;
+    int64_t i = 0;
+    EXPECT_FALSE(parseInteger("0x10", i, &why));
+    EXPECT_EQ(why, "expected a decimal integer (0x10 is hexadecimal: write 16)");
+    EXPECT_FALSE(parseInteger("010", i, &why, 0, 100));
+    EXPECT_NE(why.find("octal 8"), std::string::npos) << why;
+}
+
 TEST(Text, Utf8PathsAndNames) {
     size_t bad = 0;
     EXPECT_TRUE(isValidUtf8("η3D, εx"));

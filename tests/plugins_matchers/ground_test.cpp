@@ -116,9 +116,9 @@ TEST(GroundPlugin, RefusesACloudAlreadyInTheGroundFrame) {
 
 TEST(GroundPlugin, RefusesSettingsOutOfRange) {
     const PluginRecord &record = builtPlugins().require("ground", BINOCLE_KIND_CLOUD_TRANSFORM);
-    expectRefused<CloudTransform>(record, "inclination_deg", "95", "90", "inclination_deg = 95: expected a value <= 90");
+    expectRefused<CloudTransform>(record, "inclination_deg", "95", "90", "inclination_deg = 95: expected a decimal number >= -90 <= 90");
     expectRefused<CloudTransform>(record, "camera_height_mm", "-10", "0",
-                                  "camera_height_mm = -10: expected a value >= 0");
+                                  "camera_height_mm = -10: expected a decimal number >= 0");
 }
 
 } // namespace

@@ -105,11 +105,11 @@ TEST_P(OpenCvMatcherTest, AcceptsATypicalRigBlock) {
 
 TEST_P(OpenCvMatcherTest, RefusesNumDisparitiesNotAMultipleOf16) {
     expectRefused<Matcher>(matcherRecord(GetParam()), "num_disparities", "100", "multiple of 16",
-                           "num_disparities = 100: expected a multiple of 16");
+                           "num_disparities = 100: expected an integer multiple of 16 >= 16");
 }
 
 TEST_P(OpenCvMatcherTest, RefusesAnEvenBlockSize) {
-    expectRefused<Matcher>(matcherRecord(GetParam()), "block_size", "8", "odd", "block_size = 8: expected an odd number");
+    expectRefused<Matcher>(matcherRecord(GetParam()), "block_size", "8", "odd", "block_size = 8: expected an odd integer");
 }
 
 TEST_P(OpenCvMatcherTest, RefusesASearchWiderThanTheImage) {

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <string>
@@ -53,12 +54,17 @@ struct PaperRun {
     }
 };
 
-// One frame's input: a ground-frame cloud, its metadata and the rig.
+// One frame's input: a ground-frame cloud, its metadata, the rig, and what the host
+// learnt from the matcher and the transforms.
 struct Input {
     std::vector<float> xyz;
     std::string metadata, rig = "{}", calibration, output_dir;
     uint64_t sequence = 7;
     int32_t frame = BINOCLE_FRAME_GROUND;
+    int32_t min_disparity = 0, num_disparities = 0; // the matcher's disparity_range
+    bool ground_pose = false;                       // the ground frame's transform declared:
+    double camera_height_mm = 0, inclination_deg = 0;
+    uint32_t struct_size = sizeof(binocle_eval_input); // an older host passes less
 
     binocle_cloud cloud{};
     binocle_stereo_frame f{};
@@ -71,8 +77,13 @@ struct Input {
         f.struct_size = sizeof f;
         f.sequence = sequence;
         f.metadata = metadata.empty() ? nullptr : metadata.c_str();
-        in.struct_size = sizeof in;
+        in.struct_size = struct_size;
         in.frame = &f;
+        in.min_disparity = min_disparity;
+        in.num_disparities = num_disparities;
+        in.ground_pose_known = ground_pose ? 1 : 0;
+        in.camera_height_mm = camera_height_mm;
+        in.inclination_deg = inclination_deg;
         in.cloud = &cloud;
         in.rig_yaml = rig.c_str();
         in.calibration_yaml = calibration.empty() ? nullptr : calibration.c_str();
@@ -139,7 +150,7 @@ TEST(PaperPlugin, TruthAndGeometryFromTheSimMetadata) {
     Input input;
     input.xyz = panelScene();
     input.metadata = kSimMetadata;
-    input.rig = "{matcher: {plugin: sgbm, num_disparities: 64}}";
+    input.num_disparities = 64; // what the host's matcher answered
     run.evaluator->evaluate(input.get());
     EXPECT_EQ(run["registered"], 1);
     EXPECT_EQ(run["true_width_mm"], 2500);
@@ -154,6 +165,39 @@ TEST(PaperPlugin, TruthAndGeometryFromTheSimMetadata) {
     EXPECT_NEAR(run["horizontal_fov_deg"], 2 * std::atan(6.656 / 5.6) * 180 / M_PI, 1e-9);
     EXPECT_EQ(run["panel_fits"], 1);
     EXPECT_EQ(run.units["disparity_px"], "px");
+}
+
+// The matcher's search and the ground frame's pose come from the host (binocle_eval_input),
+// never from another plugin's keys in the rig: any matcher and any ground transform work.
+TEST(PaperPlugin, MatcherSearchAndGroundPoseComeFromTheHostNotTheRigKeys) {
+    Input input;
+    input.xyz = panelScene();
+    input.metadata = kSimMetadata;
+    input.rig = "{matcher: {plugin: sgbm, num_disparities: 16, min_disparity: 4},"
+                " transforms: [{plugin: ground, camera_height_mm: 900, inclination_deg: 7}]}";
+    input.num_disparities = 64;
+    PaperRun run("{}");
+    run.evaluator->evaluate(input.get());
+    EXPECT_NEAR(run["min_range_mm"], 280 / (0.0208 * 63), 1e-6); // 64 from 0, not 16 from 4
+
+    // An evaluator built with these fields in a host that predates them: unknown search,
+    // no pose (the E2 inclination is the default 0), nothing read past struct_size.
+    Input old = input;
+    old.struct_size = offsetof(binocle_eval_input, output_dir) + sizeof(const char *);
+    old.ground_pose = true;
+    old.inclination_deg = 5.5;
+    PaperRun older("{}");
+    older.evaluator->evaluate(old.get());
+    EXPECT_TRUE(std::isnan(older["min_range_mm"])) << older["min_range_mm"];
+
+    PaperRun e2("{experiment: e2, object: panel}");
+    e2.evaluator->evaluate(old.get());
+    EXPECT_EQ(e2["inclination_applied_deg"], 0);
+    input.ground_pose = true;
+    input.inclination_deg = 5.5;
+    PaperRun e2new("{experiment: e2, object: panel}");
+    e2new.evaluator->evaluate(input.get());
+    EXPECT_EQ(e2new["inclination_applied_deg"], 5.5);
 }
 
 TEST(PaperPlugin, SettingsOverrideTheMetadata) {
@@ -273,7 +317,9 @@ objects:
   - {name: tree, type: tree, center_mm: [1200, 9000, 3000], size_mm: [3600, 3400, 6000]}
   - {name: marker, type: box, center_mm: [-1000, 6250, 250], size_mm: [500, 500, 500]}
 )";
-    input.rig = "{transforms: [{plugin: ground, camera_height_mm: 1500, inclination_deg: 5.5}]}";
+    input.ground_pose = true; // the host: the transform that made the ground frame applied
+    input.camera_height_mm = 1500;
+    input.inclination_deg = 5.5;
     run.evaluator->evaluate(input.get());
     EXPECT_EQ(run["registered"], 1);
     EXPECT_NEAR(run["object_offset_lateral_mm"], -40, 10);

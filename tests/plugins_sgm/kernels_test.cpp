@@ -142,6 +142,28 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         ASSERT_EQ(ma, mb) << what;
                         ASSERT_EQ(sa, sb) << what;
 
+                        // No sums: the same path costs and minima as with them, in both tables.
+                        for (int scalar : {1, 0}) {
+                            std::vector<std::vector<uint8_t>> lc(3, std::vector<uint8_t>(rowBytes, sgm::kCostInvalid));
+                            std::vector<std::vector<uint8_t>> mc(3, std::vector<uint8_t>(static_cast<size_t>(width)));
+                            sgm::RowPaths rc = ra;
+                            for (int i = 0; i < n; ++i) {
+                                rc.curL[i] = lc[static_cast<size_t>(i)].data();
+                                rc.curMin[i] = mc[static_cast<size_t>(i)].data();
+                            }
+                            (scalar ? ref() : simd()).pathRow(c.cost.data(), width, c.dp, rc, c.grey.data(),
+                                                              c.greyPrev.data(), pp, nullptr, init);
+                            ASSERT_EQ(lc, la) << "no sums, scalar " << scalar << ", " << what;
+                            ASSERT_EQ(mc, ma) << "no sums, scalar " << scalar << ", " << what;
+                        }
+
+                        // A stored path row added to sums.
+                        sa = c.sum;
+                        sb = c.sum;
+                        ref().addPathRow(cases[0].prevL.data(), width, c.dp, sa.data());
+                        simd().addPathRow(cases[0].prevL.data(), width, c.dp, sb.data());
+                        ASSERT_EQ(sa, sb) << "add path row, " << what;
+
                         std::vector<uint8_t> scratch(2 * sgm::pathStride(c.dp), sgm::kCostInvalid);
                         sa = c.sum;
                         sb = c.sum;

@@ -109,7 +109,7 @@
     FIELD(binocle_cloud_transform_api, destroy, 64)                                \
     FIELD(binocle_cloud_transform_api, last_error, 72)                             \
     FIELD(binocle_cloud_transform_api, apply, 80)                                  \
-    SIZE(binocle_eval_input, 72)                                                   \
+    SIZE(binocle_eval_input, 104)                                                  \
     FIELD(binocle_eval_input, struct_size, 0)                                      \
     FIELD(binocle_eval_input, frame, 8)                                            \
     FIELD(binocle_eval_input, rectified_left, 16)                                  \
@@ -119,6 +119,11 @@
     FIELD(binocle_eval_input, calibration_yaml, 48)                                \
     FIELD(binocle_eval_input, rig_yaml, 56)                                        \
     FIELD(binocle_eval_input, output_dir, 64)                                      \
+    FIELD(binocle_eval_input, min_disparity, 72)                                   \
+    FIELD(binocle_eval_input, num_disparities, 76)                                 \
+    FIELD(binocle_eval_input, ground_pose_known, 80)                               \
+    FIELD(binocle_eval_input, camera_height_mm, 88)                                \
+    FIELD(binocle_eval_input, inclination_deg, 96)                                 \
     SIZE(binocle_evaluator_api, 96)                                                \
     FIELD(binocle_evaluator_api, header, 0)                                        \
     FIELD(binocle_evaluator_api, params, 40)                                       \
@@ -164,6 +169,7 @@
     CONSTANT(BINOCLE_PARAM_FLAG_ODD, 2)                                            \
     CONSTANT(BINOCLE_PARAM_FLAG_HAS_MIN, 4)                                        \
     CONSTANT(BINOCLE_PARAM_FLAG_HAS_MAX, 8)                                        \
+    CONSTANT(BINOCLE_PARAM_FLAG_LIMIT, 16)                                         \
     CONSTANT(BINOCLE_LOG_DEBUG, 0)                                                 \
     CONSTANT(BINOCLE_LOG_INFO, 1)                                                  \
     CONSTANT(BINOCLE_LOG_WARNING, 2)                                               \

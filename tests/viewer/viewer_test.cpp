@@ -38,13 +38,15 @@ struct Reply {
 };
 
 Reply httpRequest(uint16_t port, const std::string &target, const std::string &host,
-                  boost::beast::http::verb verb = boost::beast::http::verb::get, const std::string &body = "") {
+                  boost::beast::http::verb verb = boost::beast::http::verb::get, const std::string &body = "",
+                  const std::string &tokenHeader = "") {
     namespace http = boost::beast::http;
     boost::asio::io_context io;
     boost::asio::ip::tcp::socket socket(io);
     socket.connect({boost::asio::ip::make_address("127.0.0.1"), port});
     http::request<http::string_body> req{verb, target, 11};
     req.set(http::field::host, host);
+    if (!tokenHeader.empty()) req.set(viewer::kTokenHeader, tokenHeader);
     req.body() = body;
     req.prepare_payload();
     http::write(socket, req);
@@ -65,19 +67,9 @@ PluginHost &host() {
 
 } // namespace
 
-TEST(ViewerServer, LocalHostsOnly) {
-    using viewer::Server;
-    for (const char *ok : {"127.0.0.1", "127.0.0.1:8080", "localhost:1", "LOCALHOST", "[::1]:8080", "::1", "127.1.2.3:9"})
-        EXPECT_TRUE(Server::isLocalHost(ok, "127.0.0.1")) << ok;
-    for (const char *bad : {"", "evil.example", "evil.example:8080", "127.0.0.1.evil.example", "localhost.evil:80",
-                            "192.168.1.10:8080", "[::1]x", "127.0.0.1:80x", "10.0.0.1"})
-        EXPECT_FALSE(Server::isLocalHost(bad, "127.0.0.1")) << bad;
-    EXPECT_TRUE(Server::isLocalHost("10.0.0.1:80", "10.0.0.1")); // the address it was told to bind
-}
-
 TEST(ViewerServer, TokenAndHostGuardTheEndpoints) {
     viewer::ServerHandlers h;
-    int commands = 0;
+    std::atomic<int> commands{0};
     h.command = [&](const std::string &c) {
         ++commands;
         return std::string("{\"echo\":") + c + "}";
@@ -85,7 +77,9 @@ TEST(ViewerServer, TokenAndHostGuardTheEndpoints) {
     h.api = [](const std::string &name) {
         return name == "state" ? viewer::HttpReply{200, "application/json", "{\"ok\":true}", ""} : viewer::HttpReply{404, "", "", ""};
     };
-    viewer::Server server("127.0.0.1", 0, "secret123", h);
+    viewer::ServerOptions o;
+    o.token = "secret123";
+    viewer::Server server(o, h);
     const uint16_t port = server.port();
     const std::string local = "127.0.0.1:" + std::to_string(port);
     EXPECT_NE(server.url().find("token=secret123"), std::string::npos);
@@ -102,7 +96,10 @@ TEST(ViewerServer, TokenAndHostGuardTheEndpoints) {
     EXPECT_EQ(httpRequest(port, "/", "rebind.example").status, 403);
     EXPECT_EQ(httpRequest(port, "/api/command", local, boost::beast::http::verb::post, "{\"op\":\"x\"}").status, 403);
     EXPECT_EQ(commands, 0);
-    Reply c = httpRequest(port, "/api/command?token=secret123", local, boost::beast::http::verb::post, "{\"op\":\"x\"}");
+    // A command carries the token in its header (anti-forgery); the URL's is not enough.
+    EXPECT_EQ(httpRequest(port, "/api/command?token=secret123", local, boost::beast::http::verb::post, "{\"op\":\"x\"}").status, 403);
+    EXPECT_EQ(commands, 0);
+    Reply c = httpRequest(port, "/api/command", local, boost::beast::http::verb::post, "{\"op\":\"x\"}", "secret123");
     EXPECT_EQ(c.status, 200);
     EXPECT_EQ(c.body, "{\"echo\":{\"op\":\"x\"}}");
     EXPECT_EQ(commands, 1);
@@ -133,7 +130,9 @@ TEST(ViewerServer, ABrowserWantsAFrameOnlyAfterShowingTheLast) {
         ++commands;
         return std::string();
     };
-    viewer::Server server("127.0.0.1", 0, "tok", h);
+    viewer::ServerOptions o;
+    o.token = "tok";
+    viewer::Server server(o, h);
     EXPECT_FALSE(server.wantsFrame());
     boost::asio::io_context io;
     websocket::stream<boost::asio::ip::tcp::socket> ws(io);
@@ -162,9 +161,11 @@ TEST(ViewerServer, ABrowserWantsAFrameOnlyAfterShowingTheLast) {
 }
 
 TEST(ViewerServer, BusyPortIsNamed) {
-    viewer::Server first("127.0.0.1", 0, "t", {});
+    viewer::Server first({}, {});
     try {
-        viewer::Server second("127.0.0.1", first.port(), "t", {});
+        viewer::ServerOptions o;
+        o.port = first.port();
+        viewer::Server second(o, {});
         FAIL() << "a second server bound the same port";
     } catch (const Error &e) {
         EXPECT_NE(std::string(e.what()).find(std::to_string(first.port())), std::string::npos) << e.what();

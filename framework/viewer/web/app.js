@@ -163,6 +163,12 @@ function makeControl(key, p) {
     text.addEventListener('change', () => commit(text.value));
     row.appendChild(text);
   }
+  if (p.limit) {
+    // A resource limit: shown with its value; the server refuses it from a page.
+    row.classList.add('limit');
+    for (const input of row.querySelectorAll('input, select')) input.disabled = true;
+    label.title += ' A resource limit: set in the rig file or with --set, not from this page.';
+  }
   const err = document.createElement('div');
   err.className = 'error hidden';
   row.appendChild(err);

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// Strict readers of untrusted text, header-only: decimal integers, confined relative
-// paths and printable excerpts for messages. Binocle's own readers use these too, so a
+// Strict readers of untrusted text, header-only: numbers (binocle/numbers.hpp), confined
+// relative paths and printable excerpts for messages. Binocle's own readers use these too, so a
 // plugin that reads files of its own refuses what Binocle refuses, in the same words.
 #pragma once
+
+#include <binocle/numbers.hpp>
 
 #include <cstdint>
 #include <cstdio>
@@ -61,38 +63,6 @@ inline std::string printable(std::string_view text, size_t maxChars = 80) {
     }
     if (i < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
     return out;
-}
-
-// A decimal integer: an optional sign and digits, nothing else, within 64 bits.
-// Refused: "0640" (a leading zero reads as octal elsewhere), "0x10", "1e3", "12px",
-// " 3", "". On failure returns false and says why in `why`.
-inline bool parseDecimalInteger(std::string_view text, int64_t &out, std::string *why = nullptr) {
-    auto fail = [&](std::string what) {
-        if (why) *why = std::move(what);
-        return false;
-    };
-    size_t i = 0;
-    const bool negative = !text.empty() && text[0] == '-';
-    if (!text.empty() && (text[0] == '-' || text[0] == '+')) i = 1;
-    if (i == text.size()) return fail("expected a decimal integer");
-    for (size_t k = i; k < text.size(); ++k)
-        if (text[k] < '0' || text[k] > '9') return fail("expected a decimal integer");
-    if (text[i] == '0' && text.size() - i > 1)
-        return fail("expected a decimal integer without leading zeros (0" + std::string(text.substr(i + 1)) +
-                    " would read as octal elsewhere)");
-    // Accumulate as a negative number: INT64_MIN has no positive counterpart.
-    int64_t v = 0;
-    for (size_t k = i; k < text.size(); ++k) {
-        const int d = text[k] - '0';
-        if (v < (INT64_MIN + d) / 10) return fail("expected an integer within 64 bits");
-        v = v * 10 - d;
-    }
-    if (!negative) {
-        if (v == INT64_MIN) return fail("expected an integer within 64 bits");
-        v = -v;
-    }
-    out = v;
-    return true;
 }
 
 // A relative path that stays inside the folder it is relative to: not empty, not

@@ -1,0 +1,339 @@
+// SPDX-License-Identifier: MIT
+// mcap::Writer: chunked, compressed MCAP with message indexes, a summary with chunk
+// indexes and statistics, and a footer; each chunk whole on disk (and fsync'ed) before
+// the next one starts, so that a writer killed at any moment leaves a readable file.
+#include "mcap_bytes.hpp"
+
+#include <cerrno>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+namespace binocle::mcap {
+
+using detail::Bytes;
+
+struct Writer::Impl {
+    std::string path;
+    WriterOptions options;
+    int fd = -1;
+    uint64_t offset = 0;  // bytes in the file
+    uint32_t dataCrc = 0; // of everything before Data End
+    bool closed = false;
+
+    std::vector<Schema> schemas;
+    std::vector<Channel> channels;
+    std::vector<std::pair<std::string, KeyValues>> metadata;
+    Statistics stats;
+
+    // The open chunk: its records, and per channel the (log time, offset) of its messages.
+    Bytes chunk;
+    uint64_t chunkStart = UINT64_MAX, chunkEnd = 0;
+    std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunkIndex;
+    size_t chunkMessages = 0;
+
+    Bytes chunkIndexes; // Chunk Index records, for the summary
+
+    std::string where() const { return "mcap: " + path; }
+
+    void writeAll(const uint8_t *p, size_t n, bool data = true) {
+        if (data) dataCrc = crc32(p, n, dataCrc);
+        while (n > 0) {
+            const ssize_t w = ::write(fd, p, n);
+            if (w < 0 && errno == EINTR) continue;
+            if (w <= 0)
+                throw Error(where() + ": cannot write at offset " + std::to_string(offset) + ": " + std::strerror(errno),
+                            static_cast<int64_t>(offset));
+            p += w;
+            n -= static_cast<size_t>(w);
+            offset += static_cast<uint64_t>(w);
+        }
+    }
+    void writeAll(const Bytes &b, bool data = true) { writeAll(b.b.data(), b.b.size(), data); }
+
+    void sync() {
+        if (options.sync_chunks && ::fsync(fd) != 0)
+            throw Error(where() + ": fsync failed: " + std::strerror(errno), static_cast<int64_t>(offset));
+    }
+
+    static void schemaRecord(Bytes &b, const Schema &s) {
+        const size_t at = b.begin(Opcode::Schema);
+        b.u16(s.id);
+        b.str(s.name);
+        b.str(s.encoding);
+        b.u32(static_cast<uint32_t>(s.data.size()));
+        b.raw(s.data.data(), s.data.size());
+        b.end(at);
+    }
+    static void channelRecord(Bytes &b, const Channel &c) {
+        const size_t at = b.begin(Opcode::Channel);
+        b.u16(c.id);
+        b.u16(c.schema_id);
+        b.str(c.topic);
+        b.str(c.message_encoding);
+        b.map(c.metadata);
+        b.end(at);
+    }
+
+    void flushChunk() {
+        if (chunkMessages == 0) return;
+        const std::vector<uint8_t> &records = chunk.b;
+        const uint32_t crc = crc32(records.data(), records.size());
+        const std::vector<uint8_t> packed = detail::compress(options.compression, options.compression_level,
+                                                             records.data(), records.size());
+        Bytes out;
+        const uint64_t chunkOffset = offset;
+        const size_t at = out.begin(Opcode::Chunk);
+        out.u64(chunkStart);
+        out.u64(chunkEnd);
+        out.u64(records.size());
+        out.u32(crc);
+        out.str(compressionName(options.compression));
+        out.u64(packed.size());
+        out.raw(packed.data(), packed.size());
+        out.end(at);
+        const uint64_t chunkLength = out.b.size();
+        // Message Index records follow their chunk, one per channel.
+        std::vector<std::pair<uint16_t, uint64_t>> indexOffsets;
+        if (options.message_indexes)
+            for (auto &[channel, entries] : chunkIndex) {
+                std::stable_sort(entries.begin(), entries.end(),
+                                 [](const auto &a, const auto &b) { return a.first < b.first; });
+                indexOffsets.emplace_back(channel, chunkOffset + out.b.size());
+                const size_t mi = out.begin(Opcode::MessageIndex);
+                out.u16(channel);
+                out.u32(static_cast<uint32_t>(entries.size() * 16));
+                for (const auto &[t, o] : entries) {
+                    out.u64(t);
+                    out.u64(o);
+                }
+                out.end(mi);
+            }
+        const uint64_t indexLength = out.b.size() - chunkLength;
+        writeAll(out);
+        sync();
+
+        const size_t ci = chunkIndexes.begin(Opcode::ChunkIndex);
+        chunkIndexes.u64(chunkStart);
+        chunkIndexes.u64(chunkEnd);
+        chunkIndexes.u64(chunkOffset);
+        chunkIndexes.u64(chunkLength);
+        const size_t mapAt = chunkIndexes.b.size();
+        chunkIndexes.u32(0);
+        for (const auto &[channel, o] : indexOffsets) {
+            chunkIndexes.u16(channel);
+            chunkIndexes.u64(o);
+        }
+        chunkIndexes.patch32(mapAt, static_cast<uint32_t>(chunkIndexes.b.size() - mapAt - 4));
+        chunkIndexes.u64(indexLength);
+        chunkIndexes.str(compressionName(options.compression));
+        chunkIndexes.u64(packed.size());
+        chunkIndexes.u64(records.size());
+        chunkIndexes.end(ci);
+        ++stats.chunk_count;
+
+        chunk.b.clear();
+        chunkIndex.clear();
+        chunkMessages = 0;
+        chunkStart = UINT64_MAX;
+        chunkEnd = 0;
+    }
+
+    void finish() {
+        flushChunk();
+        Bytes tail;
+        std::vector<std::pair<uint64_t, uint64_t>> metadataAt; // offset, length
+        for (const auto &[name, values] : metadata) {
+            const uint64_t at = offset + tail.b.size();
+            const size_t r = tail.begin(Opcode::Metadata);
+            tail.str(name);
+            tail.map(values);
+            tail.end(r);
+            metadataAt.emplace_back(at, offset + tail.b.size() - at);
+        }
+        writeAll(tail);
+        Bytes end;
+        const size_t de = end.begin(Opcode::DataEnd);
+        end.u32(dataCrc);
+        end.end(de);
+        writeAll(end, false);
+
+        // The summary: one group per record kind, each found by a Summary Offset record.
+        const uint64_t summaryStart = offset;
+        Bytes s;
+        std::vector<std::tuple<Opcode, uint64_t, uint64_t>> groups;
+        auto group = [&](Opcode op, const std::function<void()> &fill) {
+            const uint64_t start = summaryStart + s.b.size();
+            fill();
+            const uint64_t length = summaryStart + s.b.size() - start;
+            if (length > 0) groups.emplace_back(op, start, length);
+        };
+        group(Opcode::Schema, [&] {
+            for (const Schema &x : schemas) schemaRecord(s, x);
+        });
+        group(Opcode::Channel, [&] {
+            for (const Channel &x : channels) channelRecord(s, x);
+        });
+        group(Opcode::Statistics, [&] {
+            const size_t r = s.begin(Opcode::Statistics);
+            s.u64(stats.message_count);
+            s.u16(stats.schema_count);
+            s.u32(stats.channel_count);
+            s.u32(stats.attachment_count);
+            s.u32(stats.metadata_count);
+            s.u32(stats.chunk_count);
+            s.u64(stats.message_start_time);
+            s.u64(stats.message_end_time);
+            const size_t m = s.b.size();
+            s.u32(0);
+            for (const auto &[c, n] : stats.channel_message_counts) {
+                s.u16(c);
+                s.u64(n);
+            }
+            s.patch32(m, static_cast<uint32_t>(s.b.size() - m - 4));
+            s.end(r);
+        });
+        if (options.chunk_indexes)
+            group(Opcode::ChunkIndex, [&] { s.raw(chunkIndexes.b.data(), chunkIndexes.b.size()); });
+        group(Opcode::MetadataIndex, [&] {
+            for (size_t i = 0; i < metadata.size(); ++i) {
+                const size_t r = s.begin(Opcode::MetadataIndex);
+                s.u64(metadataAt[i].first);
+                s.u64(metadataAt[i].second);
+                s.str(metadata[i].first);
+                s.end(r);
+            }
+        });
+        const uint64_t summaryOffsetStart = summaryStart + s.b.size();
+        for (const auto &[op, start, length] : groups) {
+            const size_t r = s.begin(Opcode::SummaryOffset);
+            s.u8(static_cast<uint8_t>(op));
+            s.u64(start);
+            s.u64(length);
+            s.end(r);
+        }
+        s.u8(static_cast<uint8_t>(Opcode::Footer));
+        s.u64(20);
+        s.u64(summaryStart);
+        s.u64(summaryOffsetStart);
+        // The summary CRC covers the summary, the offsets and the footer up to this field.
+        s.u32(crc32(s.b.data(), s.b.size()));
+        s.raw(kMagic, sizeof kMagic);
+        writeAll(s, false);
+        if (::fsync(fd) != 0) throw Error(where() + ": fsync failed: " + std::strerror(errno));
+    }
+};
+
+Writer::Writer(const std::string &path, WriterOptions options) : impl_(std::make_unique<Impl>()) {
+    impl_->path = path;
+    impl_->options = std::move(options);
+    // O_EXCL: an existing file (or a planted symlink) is never written through.
+    impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (impl_->fd < 0)
+        throw Error("mcap: cannot create " + path + ": " + std::strerror(errno) +
+                    (errno == EEXIST ? " (an existing file is never overwritten)" : ""));
+    Bytes head;
+    head.raw(kMagic, sizeof kMagic);
+    const size_t h = head.begin(Opcode::Header);
+    head.str(impl_->options.profile);
+    head.str(impl_->options.library);
+    head.end(h);
+    impl_->writeAll(head);
+}
+
+Writer::~Writer() {
+    if (!impl_ || impl_->closed) return;
+    try {
+        close();
+    } catch (...) {
+        // Destructors do not throw; what was flushed before stays readable.
+    }
+    if (impl_->fd >= 0) ::close(impl_->fd);
+}
+
+uint16_t Writer::addSchema(const std::string &name, const std::string &encoding, const std::string &data) {
+    for (const Schema &s : impl_->schemas)
+        if (s.name == name && s.encoding == encoding && s.data == data) return s.id;
+    Schema s{static_cast<uint16_t>(impl_->schemas.size() + 1), name, encoding, data};
+    // Written at once, before any chunk that uses it: a stream reader meets it first.
+    Bytes b;
+    Impl::schemaRecord(b, s);
+    impl_->writeAll(b);
+    impl_->schemas.push_back(std::move(s));
+    ++impl_->stats.schema_count;
+    return impl_->schemas.back().id;
+}
+
+uint16_t Writer::addChannel(uint16_t schema_id, const std::string &topic, const std::string &message_encoding,
+                            const KeyValues &metadata) {
+    if (schema_id != 0 && schema_id > impl_->schemas.size())
+        throw Error(impl_->where() + ": channel '" + topic + "' names schema " + std::to_string(schema_id) +
+                    ", which was not added");
+    for (const Channel &c : impl_->channels)
+        if (c.topic == topic) {
+            if (c.schema_id != schema_id || c.message_encoding != message_encoding)
+                throw Error(impl_->where() + ": topic '" + topic + "' was added before with another schema or encoding");
+            return c.id;
+        }
+    Channel c{static_cast<uint16_t>(impl_->channels.size()), schema_id, topic, message_encoding, metadata};
+    Bytes b;
+    Impl::channelRecord(b, c);
+    impl_->writeAll(b);
+    impl_->channels.push_back(std::move(c));
+    ++impl_->stats.channel_count;
+    return impl_->channels.back().id;
+}
+
+void Writer::write(uint16_t channel_id, uint32_t sequence, uint64_t log_time, uint64_t publish_time,
+                   const uint8_t *data, size_t size) {
+    Impl &w = *impl_;
+    if (w.closed) throw Error(w.where() + ": write after close");
+    if (channel_id >= w.channels.size())
+        throw Error(w.where() + ": message on channel " + std::to_string(channel_id) + ", which was not added");
+    // A chunk that would span more than chunk_span_ns is closed first: readers seek by time.
+    if (w.chunkMessages > 0 && log_time > w.chunkStart && log_time - w.chunkStart > w.options.chunk_span_ns)
+        w.flushChunk();
+    Bytes &c = w.chunk;
+    w.chunkIndex[channel_id].emplace_back(log_time, c.b.size());
+    const size_t r = c.begin(Opcode::Message);
+    c.u16(channel_id);
+    c.u32(sequence);
+    c.u64(log_time);
+    c.u64(publish_time);
+    c.raw(data, size);
+    c.end(r);
+    ++w.chunkMessages;
+    w.chunkStart = std::min(w.chunkStart, log_time);
+    w.chunkEnd = std::max(w.chunkEnd, log_time);
+    Statistics &s = w.stats;
+    s.message_start_time = s.message_count == 0 ? log_time : std::min(s.message_start_time, log_time);
+    s.message_end_time = std::max(s.message_end_time, log_time);
+    ++s.message_count;
+    ++s.channel_message_counts[channel_id];
+    if (c.b.size() >= w.options.chunk_bytes) w.flushChunk();
+}
+
+void Writer::addMetadata(const std::string &name, const KeyValues &values) {
+    impl_->metadata.emplace_back(name, values);
+    ++impl_->stats.metadata_count;
+}
+
+void Writer::flush() { impl_->flushChunk(); }
+
+void Writer::close() {
+    Impl &w = *impl_;
+    if (w.closed) return;
+    w.closed = true; // even when finishing fails: nothing more is appended
+    w.finish();
+    const int fd = w.fd;
+    w.fd = -1;
+    if (::close(fd) != 0) throw Error(w.where() + ": close failed: " + std::strerror(errno));
+}
+
+const Statistics &Writer::statistics() const { return impl_->stats; }
+uint64_t Writer::bytesWritten() const { return impl_->offset; }
+const std::string &Writer::path() const { return impl_->path; }
+
+} // namespace binocle::mcap
