@@ -10,8 +10,10 @@
 #include "input/text.hpp"
 #include "input/yaml_file.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <tuple>
 #include <opencv2/calib3d.hpp>
 #include <sstream>
 
@@ -52,6 +54,13 @@ void StereoCalibration::computeRectification() {
 
 
 namespace {
+
+// What validate() accepts beyond finiteness (calibration.hpp): a focal length of 0.01
+// (a field of view far beyond 180 degrees) to 1000 (0.06 degrees) times the image's larger
+// side; a baseline of 0.1 mm (below any stereo rig: a unit mistake or garbage) to
+// kMaxBaselineMm; a principal point within one image size of the image.
+constexpr double kFocalPerSide[2] = {0.01, 1000};
+constexpr double kMinBaselineMm = 0.1;
 
 std::string number(double v) {
     if (std::isnan(v)) return "nan"; // not "-nan": the sign of a NaN means nothing here
@@ -137,8 +146,10 @@ void requireFinite(const cv::Mat &m, const char *key, const std::string &origin)
                             std::to_string(r) + ", " + std::to_string(c) + "); expected finite numbers");
 }
 
-// A camera matrix [fx s cx; 0 fy cy; 0 0 1] with positive focal lengths.
-void checkCameraMatrix(const cv::Mat &M, const char *key, const std::string &origin) {
+// A camera matrix [fx s cx; 0 fy cy; 0 0 1] with positive focal lengths that make sense
+// for the image size (finite but absurd values, 1e-300 or 1e300, give clouds of inf, NaN
+// or points all at the origin), and its principal point on or near the image.
+void checkCameraMatrix(const cv::Mat &M, const char *key, cv::Size size, const std::string &origin) {
     requireFinite(M, key, origin);
     const double fx = M.at<double>(0, 0), fy = M.at<double>(1, 1);
     if (!(fx > 0) || !(fy > 0))
@@ -146,13 +157,33 @@ void checkCameraMatrix(const cv::Mat &M, const char *key, const std::string &ori
                     " px; expected both > 0");
     if (M.at<double>(1, 0) != 0 || M.at<double>(2, 0) != 0 || M.at<double>(2, 1) != 0 || M.at<double>(2, 2) != 1)
         throw Error(origin + ": calibration key '" + key + "': expected a camera matrix [fx 0 cx; 0 fy cy; 0 0 1]");
+    const double side = std::max(size.width, size.height);
+    const double lo = kFocalPerSide[0] * side, hi = kFocalPerSide[1] * side;
+    for (const auto &[name, f] : {std::pair<const char *, double>{"fx", fx}, {"fy", fy}})
+        if (f < lo || f > hi)
+            throw Error(origin + ": calibration key '" + key + "': focal length " + name + " = " + number(f) +
+                        " px; expected " + number(lo) + ".." + number(hi) + " px (" +
+                        number(kFocalPerSide[0]) + " to " + number(kFocalPerSide[1]) +
+                        " times the image's larger side, " + number(side) + " px)");
+    const double skew = M.at<double>(0, 1);
+    if (std::abs(skew) > hi)
+        throw Error(origin + ": calibration key '" + key + "': skew = " + number(skew) + " px; expected at most " +
+                    number(hi) + " in size");
+    // The principal point: within one image size of the image (rectified pairs and
+    // Middlebury's doffs move it, never by more than that).
+    for (const auto &[name, v, n] : {std::tuple<const char *, double, int>{"cx", M.at<double>(0, 2), size.width},
+                                     {"cy", M.at<double>(1, 2), size.height}})
+        if (v < -n || v > 2.0 * n)
+            throw Error(origin + ": calibration key '" + key + "': principal point " + name + " = " + number(v) +
+                        " px; expected " + number(-n) + ".." + number(2.0 * n) + " px (on or near the " +
+                        std::to_string(size.width) + "x" + std::to_string(size.height) + " image)");
 }
 
 } // namespace
 
 void StereoCalibration::validate(const std::string &origin) const {
-    checkCameraMatrix(M1, "M1", origin);
-    checkCameraMatrix(M2, "M2", origin);
+    checkCameraMatrix(M1, "M1", image_size, origin);
+    checkCameraMatrix(M2, "M2", image_size, origin);
     requireFinite(D1, "D1", origin);
     requireFinite(D2, "D2", origin);
     requireFinite(R, "R", origin);
@@ -162,9 +193,9 @@ void StereoCalibration::validate(const std::string &origin) const {
     if (cv::norm(err, cv::NORM_INF) > 1e-3 || std::abs(cv::determinant(R) - 1) > 1e-3)
         throw Error(origin + ": calibration key 'R' is not a rotation matrix (expected R R^T = I, det R = 1)");
     const double b = baselineMm();
-    if (!(b > 0) || b > kMaxBaselineMm)
-        throw Error(origin + ": calibration key 'T' gives a baseline of " + number(b) + " mm; expected > 0 and <= " +
-                    number(kMaxBaselineMm) + " mm");
+    if (!(b >= kMinBaselineMm) || b > kMaxBaselineMm)
+        throw Error(origin + ": calibration key 'T' gives a baseline of " + number(b) + " mm; expected " +
+                    number(kMinBaselineMm) + ".." + number(kMaxBaselineMm) + " mm");
 }
 
 StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &origin) {

@@ -1,13 +1,22 @@
 // SPDX-License-Identifier: MIT
 // Image headers checked before decoding; truncated files refused.
+// Beyond image_file.hpp: PGM/PPM headers are read exactly as OpenCV's PxM decoder reads
+// them; decodeImage has libjpeg decode a JPEG's entropy-coded data and refuses on its
+// "Corrupt JPEG data" warnings, and refuses an image decoded to another size than the
+// header checked.
 #include "input/image_file.hpp"
 
 #include "input/numbers.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <jerror.h>
+#include <jpeglib.h>
+
 #include <cctype>
 #include <cerrno>
+#include <csetjmp>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -126,64 +135,171 @@ bool inspectJpeg(const uint8_t *d, size_t size, ImageInfo &info, std::string &pr
     }
 }
 
-// Whitespace-separated header tokens of PFM/PNM ("#" comments allowed in PNM).
+// The entropy-coded data of a JPEG decoded by libjpeg, whose warnings OpenCV only
+// prints: a file cut short and given back its end marker decodes as grey "with success"
+// ("Corrupt JPEG data: premature end of data segment"). Decoded at 1/8 scale: every
+// coefficient is still Huffman-decoded (that is where the corruption shows), only the
+// inverse DCT is cheap. No C++ object lives across the setjmp/longjmp of libjpeg's
+// error exit.
+struct JpegListener {
+    jpeg_error_mgr mgr;
+    std::jmp_buf jump;
+    char message[JMSG_LENGTH_MAX];
+};
+
+void jpegErrorExit(j_common_ptr cinfo) {
+    auto *l = reinterpret_cast<JpegListener *>(cinfo->err);
+    (*cinfo->err->format_message)(cinfo, l->message);
+    std::longjmp(l->jump, 1);
+}
+
+// Warnings that mean pixels are missing or made up; the others (an unknown JFIF
+// revision or Adobe transform) are about metadata.
+void jpegMessage(j_common_ptr cinfo, int level) {
+    if (level >= 0) return; // trace messages
+    const int code = cinfo->err->msg_code;
+    if (code == JWRN_HIT_MARKER || code == JWRN_JPEG_EOF || code == JWRN_HUFF_BAD_CODE || code == JWRN_MUST_RESYNC ||
+        code == JWRN_EXTRANEOUS_DATA || code == JWRN_NOT_SEQUENTIAL || code == JWRN_BOGUS_PROGRESSION)
+        jpegErrorExit(cinfo);
+    // The arithmetic decoder's "Corrupt JPEG data: bad arithmetic code" (its code depends
+    // on the libjpeg version), by its text.
+    char text[JMSG_LENGTH_MAX];
+    (*cinfo->err->format_message)(cinfo, text);
+    if (std::strstr(text, "bad arithmetic code")) jpegErrorExit(cinfo);
+}
+
+// Returns false with libjpeg's message in `problem` when the data is corrupt.
+bool jpegDataIsWhole(const uint8_t *d, size_t size, std::string &problem) {
+    jpeg_decompress_struct cinfo;
+    JpegListener listener;
+    cinfo.err = jpeg_std_error(&listener.mgr);
+    listener.mgr.error_exit = jpegErrorExit;
+    listener.mgr.emit_message = jpegMessage;
+    listener.message[0] = 0;
+    jpeg_create_decompress(&cinfo);
+    if (setjmp(listener.jump)) {
+        jpeg_destroy_decompress(&cinfo);
+        problem = std::string("JPEG data is corrupt (libjpeg: \"") + listener.message +
+                  "\"); expected complete, uncorrupted JPEG data";
+        return false;
+    }
+    jpeg_mem_src(&cinfo, const_cast<unsigned char *>(d), static_cast<unsigned long>(size));
+    jpeg_read_header(&cinfo, TRUE);
+    cinfo.scale_num = 1;
+    cinfo.scale_denom = 8;
+    cinfo.dct_method = JDCT_IFAST;
+    jpeg_start_decompress(&cinfo);
+    JSAMPARRAY row = (*cinfo.mem->alloc_sarray)(reinterpret_cast<j_common_ptr>(&cinfo), JPOOL_IMAGE,
+                                                cinfo.output_width * cinfo.output_components, 1);
+    while (cinfo.output_scanline < cinfo.output_height) jpeg_read_scanlines(&cinfo, row, 1);
+    jpeg_finish_decompress(&cinfo);
+    jpeg_destroy_decompress(&cinfo);
+    return true;
+}
+
+// Whitespace-separated header tokens of PFM.
 struct Tokens {
     const uint8_t *d;
     size_t size, pos;
-    bool comments;
     bool next(std::string &out) {
         out.clear();
-        while (pos < size) {
-            if (comments && d[pos] == '#') {
-                while (pos < size && d[pos] != '\n') ++pos;
-            } else if (std::isspace(d[pos])) {
-                ++pos;
-            } else {
-                break;
-            }
-        }
+        while (pos < size && std::isspace(d[pos])) ++pos;
         while (pos < size && !std::isspace(d[pos]) && out.size() < 32) out += static_cast<char>(d[pos++]);
         return !out.empty() && out.size() < 32;
     }
 };
 
-bool inspectNetpbm(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
-    const bool pfm = d[1] == 'f' || d[1] == 'F';
-    info.format = pfm ? "pfm" : "pnm";
-    info.channels = (d[1] == 'F' || d[1] == '6') ? 3 : 1;
-    Tokens t{d, size, 2, !pfm};
+// One number of a binary PGM/PPM header, read exactly as OpenCV's PxM decoder reads it
+// (ReadNumber in grfmt_pxm.cpp): whitespace and '#' comments skipped, a comment ending at
+// '\n' OR '\r', then decimal digits, then ONE byte of any kind consumed. Reading the
+// header any other way lets the size checked here differ from the size OpenCV decodes
+// ("# c\r 3" is a comment then 3 to OpenCV, a comment to the end of the line to netpbm).
+// Refused where OpenCV would throw; `value` is capped well above any size limit.
+bool pxmNumber(const uint8_t *d, size_t size, size_t &pos, int64_t &value) {
+    while (true) {
+        if (pos >= size) return false;
+        const uint8_t c = d[pos];
+        if (std::isdigit(c)) break;
+        if (c == '#') {
+            ++pos;
+            while (pos < size && d[pos] != '\n' && d[pos] != '\r') ++pos;
+            if (pos >= size) return false;
+            ++pos; // the end of the comment
+        } else if (std::isspace(c)) {
+            ++pos;
+        } else {
+            return false;
+        }
+    }
+    value = 0;
+    while (pos < size && std::isdigit(d[pos])) {
+        value = value * 10 + (d[pos++] - '0');
+        if (value > INT32_MAX) return false; // OpenCV asserts here too
+    }
+    if (pos >= size) return false; // OpenCV reads one byte past the digits
+    ++pos;
+    return true;
+}
+
+bool inspectPfm(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    info.format = "pfm";
+    info.channels = d[1] == 'F' ? 3 : 1;
+    Tokens t{d, size, 2};
     std::string w, h, third, why;
     int64_t width = 0, height = 0;
     if (!t.next(w) || !t.next(h) || !t.next(third))
-        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " header is incomplete: expected width, height and " +
-                                 (pfm ? "scale" : "maximum value"));
+        return fail(problem, "PFM header is incomplete: expected width, height and scale");
     if (!parseInteger(w, width, &why, 1) || !parseInteger(h, height, &why, 1))
-        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " header: width '" + w + "' and height '" + h +
-                                 "' must be positive decimal integers");
+        return fail(problem, "PFM header: width '" + w + "' and height '" + h + "' must be positive decimal integers");
     info.width = width;
     info.height = height;
     if (!checkSize(info, problem, limits)) return false;
-    uint64_t bytesPerSample = 4;
-    if (pfm) {
-        double scale = 0;
-        if (!parseReal(third, scale, &why) || scale == 0)
-            return fail(problem, "PFM header: scale '" + third + "' must be a non-zero decimal number");
-        info.scale = scale;
-    } else {
-        int64_t maxValue = 0;
-        if (!parseInteger(third, maxValue, &why, 1, 65535))
-            return fail(problem, "PGM/PPM header: maximum value '" + third + "' must be 1..65535");
-        bytesPerSample = maxValue > 255 ? 2 : 1;
-    }
-    const size_t dataStart = t.pos + 1; // one whitespace character ends the header
-    info.dataOffset = dataStart;
-    const uint64_t need = static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * info.channels * bytesPerSample;
-    const uint64_t have = size > dataStart ? size - dataStart : 0;
-    if (have < need)
-        return fail(problem, std::string(pfm ? "PFM" : "PGM/PPM") + " pixel data is cut short: " + std::to_string(width) +
-                                 "x" + std::to_string(height) + "x" + std::to_string(info.channels) + " samples need " +
-                                 std::to_string(need) + " bytes, the file holds " + std::to_string(have));
+    double scale = 0;
+    if (!parseReal(third, scale, &why) || scale == 0)
+        return fail(problem, "PFM header: scale '" + third + "' must be a non-zero decimal number");
+    info.scale = scale;
+    info.dataOffset = t.pos + 1; // one whitespace character ends the header
     return true;
+}
+
+bool inspectPnm(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits,
+                uint64_t &bytesPerSample) {
+    info.format = "pnm";
+    info.channels = d[1] == '6' ? 3 : 1;
+    size_t pos = 2;
+    int64_t width = 0, height = 0, maxValue = 0;
+    if (!pxmNumber(d, size, pos, width) || !pxmNumber(d, size, pos, height) || !pxmNumber(d, size, pos, maxValue))
+        return fail(problem, "PGM/PPM header is incomplete or malformed: expected width, height and maximum value as "
+                             "decimal digits, separated by whitespace or '#' comments");
+    info.width = width;
+    info.height = height;
+    if (!checkSize(info, problem, limits)) return false;
+    if (maxValue < 1 || maxValue > 65535)
+        return fail(problem, "PGM/PPM header: maximum value " + std::to_string(maxValue) + " must be 1..65535");
+    bytesPerSample = maxValue > 255 ? 2 : 1;
+    info.dataOffset = pos;
+    return true;
+}
+
+// The pixel data of a PFM or binary PGM/PPM must be in the file.
+bool checkNetpbmData(size_t size, const ImageInfo &info, uint64_t bytesPerSample, std::string &problem) {
+    const uint64_t need =
+        static_cast<uint64_t>(info.width) * static_cast<uint64_t>(info.height) * info.channels * bytesPerSample;
+    const uint64_t have = size > info.dataOffset ? size - info.dataOffset : 0;
+    if (have < need)
+        return fail(problem, std::string(info.format == "pfm" ? "PFM" : "PGM/PPM") + " pixel data is cut short: " +
+                                 std::to_string(info.width) + "x" + std::to_string(info.height) + "x" +
+                                 std::to_string(info.channels) + " samples need " + std::to_string(need) +
+                                 " bytes, the file holds " + std::to_string(have));
+    return true;
+}
+
+bool inspectNetpbm(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
+    const bool pfm = d[1] == 'f' || d[1] == 'F';
+    if (pfm) return inspectPfm(d, size, info, problem, limits) && checkNetpbmData(size, info, 4, problem);
+    uint64_t bytesPerSample = 1;
+    return inspectPnm(d, size, info, problem, limits, bytesPerSample) &&
+           checkNetpbmData(size, info, bytesPerSample, problem);
 }
 
 bool inspectBmp(const uint8_t *d, size_t size, ImageInfo &info, std::string &problem, const ImageLimits &limits) {
@@ -252,6 +368,7 @@ cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::stri
     ImageInfo info;
     std::string problem;
     if (!inspectImage(data, size, info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
+    if (info.format == "jpeg" && !jpegDataIsWhole(data, size, problem)) throw ImageFileError(name + ": " + problem, false);
     cv::Mat m;
     try {
         m = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t *>(data)), flags);
@@ -260,6 +377,16 @@ cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::stri
     }
     if (m.empty())
         throw ImageFileError(name + ": cannot decode" + (info.format.empty() ? ": not an image format OpenCV reads" : " the " + info.format + " data"), false);
+    // Belt and braces: the limits were checked on the header as read here; pixels that
+    // OpenCV read to another size would have escaped them. (Width and height swapped is
+    // a JPEG's EXIF orientation applied: the same pixels, within the same limits.)
+    const bool same = m.cols == info.width && m.rows == info.height;
+    const bool turned = m.cols == info.height && m.rows == info.width;
+    if (!info.format.empty() && !same && !turned)
+        throw ImageFileError(name + ": the " + info.format + " header reads as " + std::to_string(info.width) + "x" +
+                                 std::to_string(info.height) + " pixels but decodes as " + std::to_string(m.cols) + "x" +
+                                 std::to_string(m.rows) + "; refused as ambiguous",
+                             false);
     return m;
 }
 

@@ -25,6 +25,9 @@ namespace binocle::sim {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Primitives (boxes, spheres, ...) a scene may hold: every ray is tested against them, so
+// a 100000 x 100000 cube_matrix would never render; refused when read, with the key.
+constexpr int64_t kMaxPrimitives = 10000;
 
 // Reads typed values out of YAML nodes; every error names origin:line:column and the key.
 class Reader {
@@ -246,6 +249,15 @@ private:
         }
     }
 
+    // Refuses, before anything is built, an object of `count` primitives that would take
+    // the scene past kMaxPrimitives; `key` names the setting that asked for them.
+    void budget(const YAML::Node &at, const std::string &key, int64_t count, const std::string &what) const {
+        const auto used = static_cast<int64_t>(scene_.primitives.size());
+        if (count > kMaxPrimitives - used)
+            r_.fail(at, what + ": " + key + " asks for " + std::to_string(count) + " primitives; a scene holds at most " +
+                            std::to_string(kMaxPrimitives) + " (" + std::to_string(used) + " already used)");
+    }
+
     // Per-face textures of a box: `texture` for all, then `faces: {front: ...}` overrides.
     std::array<int, 6> boxTextures(const YAML::Node &n, const std::string &what) {
         const int all = texture(n["texture"], what + ".texture", "noise");
@@ -318,6 +330,7 @@ private:
         r_.onlyKeys(n, what, {"name", "type", "cols", "rows", "cube_mm", "column_gap_mm", "row_gap_mm", "range_mm",
                               "center_x_mm", "base_z_mm", "texture", "faces"});
         const int cols = r_.integer(n, "cols", 3, 1, what), rows = r_.integer(n, "rows", 3, 1, what);
+        budget(n, "cols x rows = " + std::to_string(cols) + " x " + std::to_string(rows), int64_t{cols} * rows, what);
         const double cube = r_.positive(n, "cube_mm", 500, what);
         const double colGap = r_.number(n, "column_gap_mm", 500, what), rowGap = r_.number(n, "row_gap_mm", 250, what);
         if (colGap < 0 || rowGap < 0) r_.fail(n, what + ": gaps must be >= 0");
@@ -348,6 +361,8 @@ private:
         const double trunkHeight = r_.positive(n, "trunk_height_mm", crownHeight, what);
         const Vec3 radii = r_.positiveVec3(n, "crown_radii_mm", Vec3(1600, 1600, 1400), what);
         const int spheres = r_.integer(n, "crown_spheres", 40, 0, what);
+        budget(n["crown_spheres"] ? n["crown_spheres"] : n, "crown_spheres = " + std::to_string(spheres) + " (+ trunk and core)",
+               int64_t{spheres} + 2, what);
         std::vector<double> sr{0.25 * radii.minCoeff(), 0.45 * radii.minCoeff()};
         if (n["crown_sphere_radius_mm"]) sr = r_.list(n["crown_sphere_radius_mm"], 2, what + ".crown_sphere_radius_mm");
         if (!(sr[0] > 0 && sr[1] >= sr[0])) r_.fail(n["crown_sphere_radius_mm"], what + ".crown_sphere_radius_mm: expected [min, max], 0 < min <= max");
@@ -475,6 +490,9 @@ int Scene::addObject(const std::string &objectName, const std::string &type, std
                      std::vector<Part> parts) {
     if (prims.empty()) throw SceneError("object '" + objectName + "' has no surface");
     if (objects.size() + 2 > 65535) throw SceneError("too many objects (at most 65533)");
+    if (static_cast<int64_t>(primitives.size() + prims.size()) > kMaxPrimitives)
+        throw SceneError("object '" + objectName + "': " + std::to_string(prims.size()) +
+                         " primitives would take the scene past its limit of " + std::to_string(kMaxPrimitives));
     SceneObject o;
     o.name = objectName;
     o.type = type;

@@ -101,6 +101,11 @@ void generate(const std::string &line, const Placeholders &ph) {
         std::string bytes = readAll(w[1]);
         ASSERT_GT(bytes.size(), std::stoul(w[3])) << line;
         std::ofstream(w[2], std::ios::binary) << bytes.substr(0, std::stoul(w[3]));
+    } else if (w[0] == "truncate_close") { // cut short, then given back a JPEG end marker
+        ASSERT_EQ(w.size(), 4u) << line;
+        std::string bytes = readAll(w[1]);
+        ASSERT_GT(bytes.size(), std::stoul(w[3])) << line;
+        std::ofstream(w[2], std::ios::binary) << bytes.substr(0, std::stoul(w[3])) << "\xFF\xD9";
     } else if (w[0] == "big_yaml") {
         ASSERT_EQ(w.size(), 3u) << line;
         std::ofstream out(w[1], std::ios::binary);

@@ -269,15 +269,18 @@ TEST(SimScene, RangeMovesTheMainObjectAndMetadataFollowsTheRig) {
     EXPECT_NE(yaml.find("center_mm: [0, 11250, 1000]"), std::string::npos) << yaml;
 }
 
+// The message of the error reading `yaml` as a scene gives ("" if none).
+std::string sceneError(const std::string &yaml) {
+    try {
+        sim::Scene::fromYaml(yaml, "scene.yaml", "");
+    } catch (const sim::SceneError &e) {
+        return e.what();
+    }
+    return "";
+}
+
 TEST(SimScene, ErrorsNameFileLineAndKey) {
-    auto error = [](const std::string &yaml) {
-        try {
-            sim::Scene::fromYaml(yaml, "scene.yaml", "");
-        } catch (const sim::SceneError &e) {
-            return std::string(e.what());
-        }
-        return std::string();
-    };
+    const auto error = sceneError;
     std::string e = error("name: x\nobjects:\n  - {name: a, type: box, center_mm: [0, 1, 2], size_mm: [1, 1]}\n");
     EXPECT_NE(e.find("scene.yaml:3:"), std::string::npos) << e;
     EXPECT_NE(e.find("size_mm"), std::string::npos) << e;
@@ -289,6 +292,20 @@ TEST(SimScene, ErrorsNameFileLineAndKey) {
     EXPECT_NE(e.find("scale_mm = -4: expected a value > 0"), std::string::npos) << e;
     e = error("main_object: tree\nobjects: []\n");
     EXPECT_NE(e.find("no object named 'tree'"), std::string::npos) << e;
+}
+
+// Issue 24: a 100000 x 100000 cube_matrix hung while 1e10 boxes were built; the work is
+// bounded up front, with the key and the number allowed.
+TEST(SimScene, PrimitiveCountIsBoundedBeforeBuilding) {
+    const auto error = sceneError;
+    EXPECT_EQ(error("objects:\n  - {name: p, type: cube_matrix, cols: 100000, rows: 100000}\n"),
+              "scene.yaml:2:5: object 'p': cols x rows = 100000 x 100000 asks for 10000000000 primitives; a scene "
+              "holds at most 10000 (0 already used)");
+    EXPECT_EQ(error("objects:\n  - {name: p, type: cube_matrix, cols: 100, rows: 99}\n"
+                    "  - {name: t, type: tree, base_mm: [0, 9000, 0], crown_spheres: 99}\n"),
+              "scene.yaml:3:65: object 't': crown_spheres = 99 (+ trunk and core) asks for 101 primitives; a scene "
+              "holds at most 10000 (9900 already used)");
+    EXPECT_EQ(error("objects:\n  - {name: p, type: cube_matrix, cols: 100, rows: 100}\n"), "");
 }
 
 // An image texture tiles a face with its top row up: a picture red above, blue below,
