@@ -22,7 +22,7 @@ esac
 # zstd and lz4; the Python module: pybind11, Python's headers and numpy).
 run_packages=(
   build-essential cmake ninja-build pkg-config git ccache
-  libopencv-dev libeigen3-dev libyaml-cpp-dev libboost-dev libboost-filesystem-dev
+  libopencv-dev libjpeg-dev libeigen3-dev libyaml-cpp-dev libboost-dev libboost-filesystem-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libaravis-dev libusb-1.0-0-dev libdc1394-dev libv4l-dev
   libzstd-dev liblz4-dev
