@@ -66,6 +66,8 @@ public:
     Param &min(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MIN; d_.min = v; return *this; }
     Param &max(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MAX; d_.max = v; return *this; }
     Param &odd() { d_.flags |= BINOCLE_PARAM_FLAG_ODD; return *this; }
+    // A resource limit (memory, time): the rig or --set sets it, a live page cannot.
+    Param &limit() { d_.flags |= BINOCLE_PARAM_FLAG_LIMIT; return *this; }
     Param &multipleOf(int64_t m) { d_.multiple_of = m; return *this; }
     Param &unit(const char *u) { d_.unit = u; return *this; }
     Param &help(const char *h) { d_.help = h; return *this; }
@@ -121,6 +123,8 @@ public:
     void log(int32_t level, const std::string &msg) const {
         if (h_ && h_->log) h_->log(h_->context, level, msg.c_str());
     }
+    // Shown by `binocle --log-level debug ...`, tagged with the plugin's name.
+    void debug(const std::string &msg) const { log(BINOCLE_LOG_DEBUG, msg); }
     void info(const std::string &msg) const { log(BINOCLE_LOG_INFO, msg); }
     void warning(const std::string &msg) const { log(BINOCLE_LOG_WARNING, msg); }
     void metric(const std::string &name, double value, const std::string &unit = "") const {

@@ -31,6 +31,10 @@ typedef struct binocle_cloud {
     int32_t frame;  /* BINOCLE_FRAME_*; a transform that changes frame sets it */
 } binocle_cloud;
 
+/* A transform that puts clouds into BINOCLE_FRAME_GROUND declares the pose of Eq. 1 it
+ * applies as two DOUBLE settings named camera_height_mm and inclination_deg; the host
+ * hands their values to every evaluator (binocle_eval_input.ground_pose_known), so that
+ * no evaluator needs to know which plugin made the frame. */
 typedef struct binocle_cloud_transform_api {
     binocle_plugin_header header; /* kind == BINOCLE_KIND_CLOUD_TRANSFORM */
 

@@ -138,7 +138,9 @@ enum {
     BINOCLE_PARAM_FLAG_REQUIRED = 1u << 0, /* no default: the YAML must set it       */
     BINOCLE_PARAM_FLAG_ODD = 1u << 1,      /* INT must be odd                         */
     BINOCLE_PARAM_FLAG_HAS_MIN = 1u << 2,  /* INT/DOUBLE: value >= min                */
-    BINOCLE_PARAM_FLAG_HAS_MAX = 1u << 3   /* INT/DOUBLE: value <= max                */
+    BINOCLE_PARAM_FLAG_HAS_MAX = 1u << 3,  /* INT/DOUBLE: value <= max                */
+    BINOCLE_PARAM_FLAG_LIMIT = 1u << 4     /* a resource limit (memory, time): set in
+                                              the rig or --set, never from a live page */
 };
 
 typedef struct binocle_param_desc {

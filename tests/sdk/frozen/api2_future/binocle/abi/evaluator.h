@@ -24,7 +24,22 @@ typedef struct binocle_eval_input {
     const char *calibration_yaml;      /* OpenCV FileStorage YAML text, or NULL    */
     const char *rig_yaml;              /* the resolved rig description, YAML text   */
     const char *output_dir;            /* folder the evaluator may write into, or NULL */
+    /* Appended after API 1: read these only when struct_size reaches them
+       (BINOCLE_EVAL_INPUT_HAS); a host built before them passes a shorter struct.
+       What the host learnt through the other plugins' tables, so that an evaluator
+       reads no other plugin's settings: */
+    int32_t min_disparity;     /* the matcher's search as its disparity_range answers: */
+    int32_t num_disparities;   /* min .. min + num - 1; num 0 = unknown                 */
+    int32_t ground_pose_known; /* 1 when the cloud's ground frame (Eq. 1) was made by a
+                                  transform declaring these two settings (see
+                                  cloud_transform.h); 0: the two below mean nothing    */
+    double camera_height_mm;   /* hc: the left optical centre above the ground          */
+    double inclination_deg;    /* theta: downward pitch of the optical axis            */
 } binocle_eval_input;
+
+/* True when the host's binocle_eval_input holds `member` (an entry appended after API 1). */
+#define BINOCLE_EVAL_INPUT_HAS(input, member)                                                 \
+    ((input).struct_size >= offsetof(binocle_eval_input, member) + sizeof((input).member))
 
 typedef struct binocle_evaluator_api {
     binocle_plugin_header header; /* kind == BINOCLE_KIND_EVALUATOR */

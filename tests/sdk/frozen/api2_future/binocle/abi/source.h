@@ -65,7 +65,15 @@ typedef struct binocle_source_api {
        valid until destroy. */
     binocle_result (*calibration)(binocle_source *source, const char **yaml);
     /* Stream statistics as YAML text (frames, unpaired, missing/resent packets ...).
-       Valid until the next call on the instance. */
+       Valid until the next call on the instance; may be called before start.
+       Entries the host reads (all optional):
+         live: true        frames come on the device's own clock (a camera), so the
+                           host's default policy is `latest` (never make it wait);
+         unpaired: N       (top level) images dropped for want of a partner;
+         failed_buffers, underrun_buffers, corrupt, dropped_by_driver: N
+                           (anywhere; in a list item with `role:` for one camera)
+                           frames lost in the camera or the transport.
+       The host names these in the run's summary under `dropped`. */
     binocle_result (*statistics)(binocle_source *source, const char **yaml);
     /* Lists the devices this plugin can see, as a YAML sequence of maps with at least
        "id" and "description"; needs no instance. Valid until the next call. */
