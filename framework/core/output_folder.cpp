@@ -67,6 +67,7 @@ OutputFolder::OutputFolder(const std::string &dir, const OutputClaim &claim) : d
     const auto status = fs::symlink_status(dir, ec);
     if (fs::exists(status) && !fs::is_directory(fs::status(dir, ec)))
         throw Error("output folder " + dir + ": exists and is not a folder");
+    created_ = !fs::exists(status);
     fs::create_directories(dir, ec);
     if (ec) throw Error("output folder " + dir + ": cannot create the folder: " + ec.message());
     lock(claim.command);
@@ -142,6 +143,9 @@ void OutputFolder::release() {
     ::unlink(lockPath_.c_str());
     ::close(fd_);
     fd_ = -1;
+    // A folder this claim made and nothing was written into (the command was refused
+    // before its first output) goes again; rmdir leaves any folder that holds something.
+    if (created_) ::rmdir(dir_.c_str());
 }
 
 } // namespace binocle

@@ -52,6 +52,7 @@ private:
     std::string dir_;
     std::string lockPath_;
     int fd_ = -1;
+    bool created_ = false; // made by this claim: removed again when it ends empty (a refused run leaves nothing)
 };
 
 } // namespace binocle

@@ -118,7 +118,7 @@ TEST(CalibrationReader, ReadsWhatOpenCvWritesAndSaysWhereAFileIsWrong) {
               "FileStorage YAML calibration)");
     std::string wrong = m;
     wrong.replace(wrong.find("50., 0., 32."), 12, "50., 0x10, 32.");
-    EXPECT_EQ(readError(head + "M1: " + wrong + "M2: " + m + rt), "c.yml:8:17: calibration key 'M1' = '0x10': expected a decimal number");
+    EXPECT_EQ(readError(head + "M1: " + wrong + "M2: " + m + rt), "c.yml:8:17: calibration key 'M1' = '0x10': expected a decimal number (0x10 is hexadecimal: write 16)");
     wrong = m;
     wrong.replace(wrong.find(", 1. ]"), 6, " ]");
     EXPECT_EQ(readError(head + "M1: " + wrong + "M2: " + m + rt), "c.yml:8:10: calibration key 'M1': expected 'data' to hold 9 numbers (rows x cols), it holds 8");

@@ -83,7 +83,7 @@ TEST(Cli, RunOnAMissingRigFailsWithTheFileName) {
 
 TEST(Cli, MisspeltKeyOnTheCommandLineIsReported) {
     auto r = runCli("run " BINOCLE_SOURCE_DIR "/configs/rigs/opencv-aloe.yaml --set matcher.num_disparity=64");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(r.exit_code, 2) << r.output; // a usage error, as every bad --set
     EXPECT_NE(r.output.find("did you mean 'num_disparities'"), std::string::npos) << r.output;
 }
 

@@ -204,7 +204,7 @@ TEST(PluginLoading, SettingsTablesAreReadFromCAndCppPlugins) {
     for (const auto &d : fixture("mock_source", BINOCLE_KIND_STEREO_SOURCE).params()) names.emplace_back(d.name);
     EXPECT_EQ(names, (std::vector<std::string>{"frames", "width", "height", "disparity_px", "baseline_mm", "focal_length_px",
                                                "publish_calibration", "live", "frame_interval_ms", "fail_after", "fail_for_ms",
-                                               "fail_code"}));
+                                               "fail_code", "grow_after"}));
 }
 
 } // namespace

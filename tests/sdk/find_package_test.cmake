@@ -48,7 +48,7 @@ foreach(required include/binocle/abi.h include/binocle/abi/common.h include/bino
   endif()
 endforeach()
 foreach(file IN LISTS installed)
-  if(NOT file MATCHES "^include/binocle/(abi\\.h|abi/[a-z_]+\\.h|plugin\\.hpp|recording\\.hpp|text\\.hpp|mcap\\.hpp|ros2_messages\\.hpp)$"
+  if(NOT file MATCHES "^include/binocle/(abi\\.h|abi/[a-z_]+\\.h|plugin\\.hpp|recording\\.hpp|text\\.hpp|mcap\\.hpp|ros2_messages\\.hpp|settings\\.hpp|numbers\\.hpp)$"
      AND NOT file MATCHES "/cmake/Binocle/[A-Za-z_-]+\\.cmake$" AND NOT file MATCHES "^lib[^/]*/libbinocle_mcap\\.a$")
     message(FATAL_ERROR "the SDK install holds ${file}: only the public headers and the CMake package belong to it")
   endif()

@@ -96,14 +96,23 @@ def recv_exact(s, n):
     return out
 
 
-def ws_recv(s):
+def ws_frame(s):
     b0, b1 = recv_exact(s, 2)
     n = b1 & 0x7F
     if n == 126:
         n = struct.unpack(">H", recv_exact(s, 2))[0]
     elif n == 127:
         n = struct.unpack(">Q", recv_exact(s, 8))[0]
-    return b0 & 0x0F, recv_exact(s, n)
+    return bool(b0 & 0x80), b0 & 0x0F, recv_exact(s, n)
+
+
+def ws_recv(s):
+    """One whole message: a server may fragment it (Beast does past its write buffer)."""
+    fin, op, data = ws_frame(s)
+    while not fin:
+        fin, _, more = ws_frame(s)  # continuation frames (op 0)
+        data += more
+    return op, data
 
 
 def ws_reply(s, command, timeout=30):
