@@ -38,6 +38,12 @@ struct Reader::Impl {
     std::vector<ChunkInfo> chunks;
     std::vector<uint64_t> looseMessages; // offsets of Message records outside chunks (scan)
     Statistics stats;
+
+    // Here and not in ~Reader: a file refused while opening (the constructor throws, so
+    // ~Reader never runs) still has its descriptor closed.
+    ~Impl() {
+        if (fd >= 0) ::close(fd);
+    }
     bool indexed = false;
     std::string note;
     std::vector<std::pair<std::string, KeyValues>> metadata;
@@ -517,9 +523,7 @@ Reader::Reader(const std::string &path, ReaderOptions options) : impl_(std::make
     impl_->open();
 }
 
-Reader::~Reader() {
-    if (impl_ && impl_->fd >= 0) ::close(impl_->fd);
-}
+Reader::~Reader() = default;
 
 const std::string &Reader::path() const { return impl_->path; }
 const std::string &Reader::profile() const { return impl_->profile; }

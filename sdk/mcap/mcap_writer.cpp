@@ -240,7 +240,16 @@ Writer::Writer(const std::string &path, WriterOptions options) : impl_(std::make
     head.str(impl_->options.profile);
     head.str(impl_->options.library);
     head.end(h);
-    impl_->writeAll(head);
+    try {
+        impl_->writeAll(head);
+    } catch (...) {
+        // The constructor throws, so ~Writer never runs: no descriptor kept open, and no
+        // half-written file (this writer made it, O_EXCL) left behind.
+        ::close(impl_->fd);
+        impl_->fd = -1;
+        ::unlink(path.c_str());
+        throw;
+    }
 }
 
 Writer::~Writer() {

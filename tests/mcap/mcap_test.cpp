@@ -287,6 +287,23 @@ TEST_F(McapBad, NotAnMcapFile) {
     EXPECT_NE(readError({}).find("expected an MCAP file"), std::string::npos);
 }
 
+// A file refused while opening leaves no descriptor open: a replay that tries many files,
+// or a fuzzer, would otherwise run out of them (found by mcap_reader_fuzz in CI).
+TEST_F(McapBad, RefusedFileLeavesNoDescriptorOpen) {
+    auto countFds = [] {
+        return std::distance(fs::directory_iterator("/proc/self/fd"), fs::directory_iterator{});
+    };
+    auto b = bytes_;
+    b[1] = 'X';
+    spit(dir_ / "bad.mcap", b);
+    const auto before = countFds();
+    for (int i = 0; i < 50; ++i) {
+        EXPECT_THROW(mcap::Reader((dir_ / "bad.mcap").string()), mcap::Error);
+        EXPECT_THROW(mcap::Reader(dir_.string()), mcap::Error); // not a regular file
+    }
+    EXPECT_EQ(countFds(), before);
+}
+
 TEST_F(McapBad, ChunkCrcMismatchNamesTheChunk) {
     auto b = bytes_;
     b[chunk_.offset + chunk_.length - 100] ^= 0x55; // a byte of the records (uncompressed)
