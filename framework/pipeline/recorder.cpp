@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
+#include "host/plugin_instance.hpp"
 #include "rosbag/rosbag_recording.hpp"
 
 #include <binocle/recording.hpp>
@@ -35,6 +36,18 @@
 namespace fs = std::filesystem;
 
 namespace binocle {
+
+cv::Mat recordableView(const binocle_image &im) {
+    switch (im.format) {
+    case BINOCLE_PIXEL_GRAY8:
+    case BINOCLE_PIXEL_GRAY16:
+    case BINOCLE_PIXEL_BGR8:
+    case BINOCLE_PIXEL_RGB8: return view(im);
+    default:
+        throw Error("record: images of format " + std::to_string(im.format) +
+                    " cannot be recorded (GRAY8, GRAY16, BGR8 or RGB8)");
+    }
+}
 
 namespace {
 
@@ -82,19 +95,6 @@ std::string diskOf(const std::string &dir) {
     return note;
 }
 
-// A lent image as a cv::Mat view; RGB8 is flagged so that PNG gets the right colours.
-cv::Mat view(const binocle_image &im, bool &rgb) {
-    rgb = im.format == BINOCLE_PIXEL_RGB8;
-    int type = 0;
-    switch (im.format) {
-    case BINOCLE_PIXEL_GRAY8: type = CV_8UC1; break;
-    case BINOCLE_PIXEL_BGR8:
-    case BINOCLE_PIXEL_RGB8: type = CV_8UC3; break;
-    case BINOCLE_PIXEL_GRAY16: type = CV_16UC1; break;
-    default: throw Error("record: images of format " + std::to_string(im.format) + " cannot be recorded (GRAY8, GRAY16, BGR8 or RGB8)");
-    }
-    return cv::Mat(im.height, im.width, type, im.data, static_cast<size_t>(im.stride_bytes));
-}
 
 } // namespace
 
@@ -375,10 +375,10 @@ bool RecordingWriter::submit(uint64_t sequence, int64_t timestampLeftNs, int64_t
 
 bool RecordingWriter::submit(const LentFrame &frame, bool wait) {
     const binocle_stereo_frame &f = frame.raw();
-    bool rgbLeft = false, rgbRight = false;
     // Copies: the source's buffers go back as soon as the caller releases the frame.
-    cv::Mat left = view(f.left, rgbLeft).clone(), right = view(f.right, rgbRight).clone();
-    return submit(f.sequence, f.timestamp_left_ns, f.timestamp_right_ns, std::move(left), std::move(right), rgbLeft || rgbRight, wait);
+    const bool rgb = f.left.format == BINOCLE_PIXEL_RGB8 || f.right.format == BINOCLE_PIXEL_RGB8;
+    cv::Mat left = recordableView(f.left).clone(), right = recordableView(f.right).clone();
+    return submit(f.sequence, f.timestamp_left_ns, f.timestamp_right_ns, std::move(left), std::move(right), rgb, wait);
 }
 
 void RecordingWriter::finish() {

@@ -19,6 +19,10 @@
 
 namespace binocle {
 
+// A lent image as a cv::Mat view (no copy) for a recording; refuses formats no recording
+// holds (GRAY8, GRAY16, BGR8, RGB8 are recorded; RGB8 stays in RGB order here).
+cv::Mat recordableView(const binocle_image &im);
+
 // How a RecordingWriter spreads its work.
 struct RecordingWriterOptions {
     int threads = 0;            // threads that encode and write images; 0 = two per core, 4..16

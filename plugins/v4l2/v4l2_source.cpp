@@ -3,8 +3,10 @@
 // pairing of two devices by time stamp, side-by-side splitting, conversion, lending of
 // buffers and the errors a user reads.
 //
-// Read top to bottom: settings, errors, one device (Stream), conversion, the source.
+// Read top to bottom: settings, conversion, the source. One opened device (Stream) and
+// the errors a user reads from the kernel's answers are in v4l2_stream.*.
 #include "v4l2_source.hpp"
+#include "v4l2_stream.hpp"
 
 #include <linux/videodev2.h>
 
@@ -99,62 +101,6 @@ Settings readSettings(const sdk::Params &p) {
     return s;
 }
 
-// ---- Errors ----------------------------------------------------------------------------------
-
-const char *errnoName(int e) {
-    switch (e) {
-    case ENOENT: return "ENOENT";
-    case ENODEV: return "ENODEV";
-    case ENXIO: return "ENXIO";
-    case EBUSY: return "EBUSY";
-    case EACCES: return "EACCES";
-    case EPERM: return "EPERM";
-    case EINVAL: return "EINVAL";
-    case ENOTTY: return "ENOTTY";
-    case EIO: return "EIO";
-    case ENOMEM: return "ENOMEM";
-    case EPIPE: return "EPIPE";
-    default: return "errno";
-    }
-}
-
-std::string devicesHere() {
-    std::vector<std::string> paths;
-    try {
-        paths = deviceSystem().listDevices();
-    } catch (...) {
-    }
-    if (paths.empty()) return "no V4L2 device on this machine";
-    std::string all;
-    for (const auto &p : paths) all += (all.empty() ? "" : ", ") + p;
-    return "V4L2 devices here: " + all;
-}
-
-// Turns what the kernel said into what a user reads. `doing` says what was under way.
-[[noreturn]] void throwFor(const std::string &path, const DeviceError &e, const std::string &doing) {
-    const std::string call = std::string(" (") + errnoName(e.err()) + " in " + e.call() + ")";
-    switch (e.err()) {
-    case ENOENT:
-        throw Error(BINOCLE_ERR_NOT_FOUND, "v4l2: " + path + ": no such device" + call + " while " + doing + "; " +
-                                               devicesHere());
-    case ENODEV:
-    case ENXIO:
-        throw Error(BINOCLE_ERR_DEVICE, "v4l2: " + path + " went away" + call + " while " + doing +
-                                            ": the device was unplugged or its driver reset it");
-    case EBUSY:
-        throw Error(BINOCLE_ERR_BUSY, "v4l2: " + path + " is busy" + call + " while " + doing +
-                                          ": another program (or another source of this rig) is using it");
-    case EACCES:
-    case EPERM:
-        throw Error(BINOCLE_ERR_IO, "v4l2: " + path + ": permission denied" + call + " while " + doing +
-                                        "; is the user in the group that owns it (usually 'video')?");
-    case ENOTTY:
-        throw Error(BINOCLE_ERR_UNSUPPORTED, "v4l2: " + path + " is not a V4L2 device" + call + " while " + doing);
-    default:
-        throw Error(BINOCLE_ERR_DEVICE, "v4l2: " + path + ": " + e.what() + call + " while " + doing);
-    }
-}
-
 int bytesPerPixel(uint32_t fourcc) {
     switch (fourcc) {
     case V4L2_PIX_FMT_GREY: return 1;
@@ -185,102 +131,6 @@ int64_t nowNs() {
 }
 
 } // namespace
-
-// ---- One device --------------------------------------------------------------------------------
-
-// An opened device with its buffers. Shared by the source and by every frame lent from
-// its buffers, so that the mappings outlive whichever goes last. Device calls and the
-// book-keeping below happen under `mutex`, except waiting (poll), so that a frame can be
-// released from another thread while grab waits.
-class Stream {
-public:
-    Stream(std::unique_ptr<Device> device, std::string role)
-        : path(device->path()), role(std::move(role)), device_(std::move(device)) {}
-
-    ~Stream() {
-        std::lock_guard<std::mutex> lock(mutex);
-        try {
-            if (streaming) device_->streamOff();
-        } catch (...) {
-        }
-        for (uint32_t i = 0; i < buffers.size(); ++i) {
-            try {
-                device_->unmapBuffer(i);
-            } catch (...) {
-            }
-        }
-        try {
-            if (!buffers.empty()) device_->requestBuffers(0);
-        } catch (...) {
-        }
-    }
-
-    Stream(const Stream &) = delete;
-    Stream &operator=(const Stream &) = delete;
-
-    Device &device() { return *device_; }
-
-    // A lent buffer comes back (a frame's onRelease, any thread). Never throws.
-    void giveBack(uint32_t index) noexcept {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (index >= lent.size() || !lent[index]) return;
-        lent[index] = 0;
-        if (!streaming || !gone.empty()) return; // queued again at the next start, or never
-        try {
-            device_->queueBuffer(index);
-            ++requeued;
-        } catch (const DeviceError &e) {
-            try {
-                failLocked(e, "giving a released buffer back to the driver"); // remembers a vanished device
-            } catch (...) {
-            }
-        } catch (...) {
-        }
-    }
-
-    // Back to the driver after use (grab's thread). Caller holds no lock.
-    void requeue(uint32_t index) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!streaming) return;
-        try {
-            device_->queueBuffer(index);
-            ++requeued;
-        } catch (const DeviceError &e) {
-            failLocked(e, "giving buffer " + std::to_string(index) + " back to the driver");
-        }
-    }
-
-    uint32_t lentCount() const {
-        return static_cast<uint32_t>(std::count(lent.begin(), lent.end(), static_cast<char>(1)));
-    }
-
-    // Remembers a vanished device (so that every later call says so) and throws.
-    [[noreturn]] void failLocked(const DeviceError &e, const std::string &doing) {
-        try {
-            throwFor(path, e, doing + " (" + role + ", after " + std::to_string(dequeued) + " frames)");
-        } catch (const Error &err) {
-            if (err.code() == BINOCLE_ERR_DEVICE && (e.err() == ENODEV || e.err() == ENXIO)) gone = err.what();
-            throw;
-        }
-    }
-
-    std::mutex mutex;
-    std::string path, role;
-    Capability capability;
-    PixFormat format;
-    double fpsGranted = 0;
-    std::vector<Mapping> buffers;
-    std::vector<char> lent; // by buffer index: 1 while the host holds it
-    bool streaming = false;
-    std::string gone; // the message, once the device went away
-
-    // Statistics.
-    uint64_t dequeued = 0, corrupt = 0, unpaired = 0, requeued = 0, droppedByDriver = 0;
-    int64_t lastSequence = -1;
-
-private:
-    std::unique_ptr<Device> device_;
-};
 
 // ---- The source --------------------------------------------------------------------------------
 

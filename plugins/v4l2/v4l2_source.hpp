@@ -31,7 +31,7 @@ struct Settings {
     double pairToleranceMs = 0; // 0: half the frame period
 };
 
-class Stream; // one opened device and its buffers (v4l2_source.cpp)
+class Stream; // one opened device and its buffers (v4l2_stream.hpp)
 
 class V4l2Source : public sdk::StereoSource {
 public:
