@@ -18,20 +18,6 @@ std::optional<StereoCalibration> parseCalibration(const std::string &yaml) {
     return StereoCalibration::fromYaml(yaml, "the rig's calibration");
 }
 
-// A lent image as a cv::Mat view (GRAY8, GRAY16, BGR8, RGB8).
-cv::Mat view(const binocle_image &im) {
-    int type = 0;
-    switch (im.format) {
-    case BINOCLE_PIXEL_GRAY8: type = CV_8UC1; break;
-    case BINOCLE_PIXEL_BGR8:
-    case BINOCLE_PIXEL_RGB8: type = CV_8UC3; break;
-    case BINOCLE_PIXEL_GRAY16: type = CV_16UC1; break;
-    default:
-        throw Error("record: images of format " + std::to_string(im.format) +
-                    " cannot be recorded (GRAY8, GRAY16, BGR8 or RGB8)");
-    }
-    return cv::Mat(im.height, im.width, type, im.data, static_cast<size_t>(im.stride_bytes));
-}
 } // namespace
 
 RosbagRecordingWriter::RosbagRecordingWriter(const std::string &dir, const std::string &calibrationYaml,
@@ -95,8 +81,8 @@ bool RosbagRecordingWriter::submit(const LentFrame &frame, bool wait) {
     Job job;
     job.tl = f.timestamp_left_ns;
     job.tr = f.timestamp_right_ns;
-    job.left = view(f.left).clone(); // the source gets its buffers back at once
-    job.right = view(f.right).clone();
+    job.left = recordableView(f.left).clone(); // the source gets its buffers back at once
+    job.right = recordableView(f.right).clone();
     job.rgb = f.left.format == BINOCLE_PIXEL_RGB8;
     std::unique_lock<std::mutex> lock(mutex_);
     if (!error_.empty()) throw Error(error_);
