@@ -121,11 +121,9 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
 // derives it, from the same sums); a left pixel whose disparity differs from its right
 // match's by more than disp12_max_diff is invalid (occluded or mismatched).
 void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
-    const WtaParams wp{settings_.minDisparity, settings_.numDisparities, paddedDisp_, settings_.uniquenessPercent,
-                       settings_.subpixel};
-    uint16_t *out = fixed_.ptr<uint16_t>(y);
-    kernels_.wtaRow(sum, width_, wp, s.best.data(), s.bestSum.data(), out);
+    if (sum) kernels_.wtaRow(sum, width_, wtaParams(), s.best.data(), s.bestSum.data(), fixed_.ptr<uint16_t>(y));
     if (settings_.disp12MaxDiff < 0) return;
+    uint16_t *out = fixed_.ptr<uint16_t>(y);
     std::fill(s.rightBest.begin(), s.rightBest.end(), -1);
     std::fill(s.rightSum.begin(), s.rightSum.end(), 0xFFFF);
     for (int x = 0; x < width_; ++x) {
@@ -193,9 +191,16 @@ void Engine::matchStripe(int index, int y0, int y1) {
                 rp.curMin[i] = pathMin(i, parity);
                 prevRowL[i] = rp.curL[i];
             }
-            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
-            if (own && keepDownPath_ && !down) kernels_.addPathRow(downPathRow(y), width_, paddedDisp_, sum);
-            if (own && (down != twoPass_)) finishRow(s, sum, y);
+            if (own && keepDownPath_ && !down) {
+                // The vertical path, the sums and the winner in one kernel; then the check.
+                kernels_.upWtaRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp,
+                                  downPathRow(y), sum, wtaParams(), s.best.data(), s.bestSum.data(),
+                                  fixed_.ptr<uint16_t>(y));
+                finishRow(s, nullptr, y);
+            } else {
+                kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
+                if (own && (down != twoPass_)) finishRow(s, sum, y);
+            }
             parity ^= 1;
             if (y == yLast) break;
         }

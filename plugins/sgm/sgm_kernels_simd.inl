@@ -31,6 +31,17 @@ static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole 
 
 inline int addSat(int a, int b) { return a + b > 255 ? 255 : a + b; }
 
+// Bits set in each 64-bit lane. OpenCV's 256-bit v_popcount takes two byte-table lookups
+// and a sum of absolute differences; a CPU with AVX-512 VPOPCNTDQ counts them in one
+// instruction (the avx512 table, sgm_kernels_avx512.cpp, the same 256-bit code otherwise).
+inline v_uint64 popcount64(const v_uint64 &a) {
+#if defined(SGM_SIMD_VPOPCNT)
+    return v_uint64(_mm256_popcnt_epi64(a.val));
+#else
+    return v_popcount(a);
+#endif
+}
+
 // ---- census ---------------------------------------------------------------------------
 // kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
 // byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
@@ -103,6 +114,9 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
             plane[q] = j < static_cast<size_t>(width) ? right[width - 1 - j] : 0;
         }
     }
+    // planes[s]: plane s mod 8, one word further on for s >= 8.
+    const uint64_t *planes[16];
+    for (int s = 0; s < 16; ++s) planes[s] = scratch + (s & 7) * words + (s >> 3);
     alignas(64) uint8_t iotaBytes[kLanes8];
     for (int i = 0; i < kLanes8; ++i) iotaBytes[i] = static_cast<uint8_t>(i);
     const v_uint8 iota = vx_load_aligned(iotaBytes);
@@ -114,14 +128,16 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
         const int valid = std::min(numDisp, x - minD + 1);
         uint8_t *out = cost + static_cast<size_t>(x) * paddedDisp;
         for (int d0 = 0; d0 < paddedDisp; d0 += kLanes8) {
-            const int at = base + d0, q = at >> 3, r = at & 7;
-            v_uint64 word = vx_setzero_u64();
-            for (int k = 0; k < 8; ++k) {
-                const int s = r + k;
-                const uint64_t *plane = scratch + (s & 7) * words + q + (s >> 3);
-                word = word | (v_popcount(vx_load(plane) ^ centre) << (8 * k));
-            }
-            v_uint8 c = v_reinterpret_as_u8(word);
+            const int at = base + d0, q = at >> 3;
+            const uint64_t *const *p = planes + (at & 7);
+            // Written out: constant shifts, and two independent halves.
+            const v_uint64 w0 = popcount64(vx_load(p[0] + q) ^ centre) | v_shl<8>(popcount64(vx_load(p[1] + q) ^ centre)) |
+                                v_shl<16>(popcount64(vx_load(p[2] + q) ^ centre)) |
+                                v_shl<24>(popcount64(vx_load(p[3] + q) ^ centre));
+            const v_uint64 w1 = popcount64(vx_load(p[4] + q) ^ centre) | v_shl<8>(popcount64(vx_load(p[5] + q) ^ centre)) |
+                                v_shl<16>(popcount64(vx_load(p[6] + q) ^ centre)) |
+                                v_shl<24>(popcount64(vx_load(p[7] + q) ^ centre));
+            v_uint8 c = v_reinterpret_as_u8(w0 | v_shl<32>(w1));
             const int lanes = valid - d0;
             if (lanes < kLanes8) c = v_select(iota < vx_setall_u8(static_cast<uint8_t>(lanes > 0 ? lanes : 0)), c, invalid);
             v_store(out + d0, c);
@@ -144,10 +160,11 @@ const uint8_t *freshPath() {
 // L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + P1, min L(q) + P2) - min L(q) for the
 // paths of a row side by side, pixel by pixel, so that the 16-bit sums are read and
 // written once per pixel whatever the number of paths.
-void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+// The number of paths is a template argument: the per-path vectors stay in registers.
+template <int n>
+void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+               const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
     const int stride = pathStride(paddedDisp);
-    const int n = paths.count;
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     for (int x = 0; x < width; ++x) {
         const uint8_t *prev[kMaxRowPaths];
@@ -202,6 +219,13 @@ void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pat
         }
         for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
     }
+}
+
+void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+    if (paths.count == 1) pathRowOf<1>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
+    else if (paths.count == 2) pathRowOf<2>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
+    else pathRowOf<kMaxRowPaths>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
 }
 
 // Both horizontal paths of a row, left to right and right to left, interleaved: each is
@@ -279,49 +303,117 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 }
 
 // ---- winner takes all -----------------------------------------------------------------
+// q = floor(n / a) for 0 <= n < 2^23, 1 <= a <= 100, by a multiplication (no integer
+// division per pixel): with M = floor(2^40 / a) + 1 = (2^40 + e) / a, 0 < e <= a,
+// n * M / 2^40 = n / a + n * e / (a * 2^40), and n * e < 2^40 keeps the floor exact.
+struct Divider {
+    int a;
+    uint64_t m;
+    explicit Divider(int divisor) : a(divisor), m((uint64_t(1) << 40) / static_cast<uint64_t>(divisor) + 1) {}
+    int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
+};
+
+// One pixel's winner takes all, its least sum m already known.
+inline void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
+                     uint16_t *bestSum, uint16_t *disparity16) {
+    const int whole = wp.numDisp / kLanes16 * kLanes16;
+    // One more pass finds the lowest d holding the least sum and counts the sums below
+    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
+    const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
+    const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
+    const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
+    int b = -1;
+    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
+    for (int d = 0; d < whole; d += kLanes16) {
+        const v_uint16 v = vx_load(s + d);
+        if (b < 0) {
+            const unsigned eq = static_cast<unsigned>(v_signmask(v == vm));
+            if (eq != 0) b = d + __builtin_ctz(eq);
+        }
+        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
+    }
+    int below = static_cast<int>(v_reduce_sum(counts));
+    for (int d = whole; d < wp.numDisp; ++d) {
+        if (b < 0 && s[d] == m) b = d;
+        below += s[d] < threshold;
+    }
+    bestSum[x] = static_cast<uint16_t>(m);
+    if (x - wp.minDisparity - b < 0) {
+        best[x] = -1;
+        disparity16[x] = 0;
+        return;
+    }
+    best[x] = static_cast<int16_t>(b);
+    // Those at b - 1, b, b + 1 do not count.
+    for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
+    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+}
+
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
             uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
+    const Divider divide(100 - wp.uniquenessPercent);
     for (int x = 0; x < width; ++x) {
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
         int m = v_reduce_min(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
-        // One more pass finds the lowest d holding the least sum and counts the sums below
-        // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
-        const int a = 100 - wp.uniquenessPercent;
-        const int threshold = std::min(65535, (m * 100 + a - 1) / a);
-        const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
-        const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
-        int b = -1, below = 0;
-        for (int d = 0; d < whole; d += kLanes16) {
-            const v_uint16 v = vx_load(s + d);
-            const unsigned eq = static_cast<unsigned>(v_signmask(v == vm));
-            if (b < 0 && eq != 0) b = d + __builtin_ctz(eq);
-            below += __builtin_popcount(static_cast<unsigned>(v_signmask(v < vt)));
+        wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
+    }
+}
+
+// The pass up of 4 paths, fused (sgm_kernels.hpp): per pixel the vertical path from
+// below, the sums of the four paths in a buffer that stays in L1 (nothing 16-bit is
+// stored to the row), their minimum on the way, then the winner takes all.
+void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    const int stride = pathStride(paddedDisp);
+    const int whole = wp.numDisp / kLanes16 * kLanes16;
+    const Divider divide(100 - wp.uniquenessPercent);
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    alignas(64) uint16_t local[kDispAlign * 8];
+    for (int x = 0; x < width; ++x) {
+        const bool has = paths.prevL[0] != nullptr;
+        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(x) * stride + 1 : freshPath();
+        const int minPrev = has ? paths.prevMin[0][x] : 255;
+        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[x])] : pp.p2Lut[0];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        v_uint8 least = vx_setall_u8(255);
+        v_uint16 leastSum = vx_setall_u16(0xFFFF);
+        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
+        const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const uint8_t *q = prev + d;
+            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+            v_store(out + d, l);
+            least = v_min(least, l);
+            v_uint16 l0, l1, k0lo, k0hi;
+            v_expand(l, l0, l1);
+            v_expand(vx_load(k0 + d), k0lo, k0hi);
+            const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
+            const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
+            v_store(local + d, lo);
+            v_store(local + d + kLanes16, hi);
+            if (d < whole) leastSum = v_min(leastSum, lo);
+            if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
         }
-        for (int d = whole; d < wp.numDisp; ++d) {
-            if (b < 0 && s[d] == m) b = d;
-            below += s[d] < threshold;
-        }
-        bestSum[x] = static_cast<uint16_t>(m);
-        if (x - wp.minDisparity - b < 0) {
-            best[x] = -1;
-            disparity16[x] = 0;
-            continue;
-        }
-        best[x] = static_cast<int16_t>(b);
-        // Those at b - 1, b, b + 1 do not count.
-        for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
-        disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+        paths.curMin[0][x] = v_reduce_min(least);
+        int m = v_reduce_min(leastSum);
+        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, local[d]);
+        wtaPixel(local, m, x, wp, divide, best, bestSum, disparity16);
     }
 }
 
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, addPathRow, wtaRow};
+    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, addPathRow, wtaRow, upWtaRow};
     return k;
 }
 
