@@ -44,7 +44,7 @@ double Engine::workingBytes(int width, int height) const {
     // 8-bit costs, and the 16-bit sums (8 paths) or the 8-bit vertical path (4 paths).
     const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
-    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 2 /* scratch sums */ + 8 * w +
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 4 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
     return volume + images + std::max(1, settings_.stripes) * stripe;
 }
@@ -79,7 +79,7 @@ void Engine::prepare(int width, int height) {
         s.pathRows.assign(6 * w * ds, kCostInvalid);
         s.pathMins.assign(6 * w, 0);
         s.horizontal.assign(2 * ds, kCostInvalid);
-        s.scratchSum.assign(w * dp, 0);
+        s.scratchSum.assign(2 * w * dp, 0); // two rows: the horizontal paths run two at once
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
         s.rightBest.assign(w, -1);
@@ -158,7 +158,7 @@ void Engine::matchStripe(int index, int y0, int y1) {
 
     const uint8_t *prevRowL[kMaxRowPaths] = {};
     auto run = [&](const std::vector<int> &dxs, int yFirst, int yLast, int step, bool down) {
-        int parity = 0;
+        int parity = 0, pairedRow = -1;
         for (int y = yFirst;; y += step) {
             const bool own = y >= y0 && y < y1;
             const uint8_t *cost = costRow(s, y, own, down);
@@ -166,9 +166,23 @@ void Engine::matchStripe(int index, int y0, int y1) {
             uint16_t *sum = nullptr;
             if (own && keepDownPath_) {
                 if (!down) { // the horizontal paths first, then this pass's and the kept vertical
-                    sum = s.scratchSum.data();
-                    kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
-                                           s.horizontal.data(), sum, true);
+                    // Those of two rows at once (four serial chains side by side, whose
+                    // latencies overlap): this one's, and the next one's for the next step.
+                    uint16_t *second = s.scratchSum.data() + w * paddedDisp_;
+                    const int next = y + step;
+                    if (y == pairedRow) {
+                        sum = second;
+                    } else if (y != yLast && next >= y0 && next < y1) {
+                        sum = s.scratchSum.data();
+                        kernels_.horizontalRows(cost, costRow(s, next, true, false), width_, paddedDisp_,
+                                                greyLeft_.ptr<uint8_t>(y), greyLeft_.ptr<uint8_t>(next), pp,
+                                                s.horizontal.data(), sum, second);
+                        pairedRow = next;
+                    } else {
+                        sum = s.scratchSum.data();
+                        kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                                               s.horizontal.data(), sum, true);
+                    }
                 }
             } else if (own) {
                 // The pass down stores the horizontal paths' sums; the rest add to them (the

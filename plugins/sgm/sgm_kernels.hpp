@@ -75,6 +75,12 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
 
+// Both horizontal paths of two rows (costs cost0 and cost1, intensities grey0 and grey1),
+// stored to sum0 and sum1: horizontalRow with initSum for each, run side by side.
+using HorizontalRowsFn = void (*)(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp,
+                                  const uint8_t *grey0, const uint8_t *grey1, const PathParams &pp, uint8_t *scratch,
+                                  uint16_t *sum0, uint16_t *sum1);
+
 // Adds one stored path row (the path-row layout above) to a row of sums: the pass up of
 // 4 paths adds the pass down's vertical path, kept as 8-bit costs.
 using AddPathRowFn = void (*)(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum);
@@ -110,6 +116,7 @@ struct Kernels {
     CostRowFn costRow;
     PathRowFn pathRow;
     HorizontalRowFn horizontalRow;
+    HorizontalRowsFn horizontalRows;
     AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
     UpWtaRowFn upWtaRow;

@@ -109,6 +109,12 @@ void horizontalRowScalar(const uint8_t *cost, int width, int paddedDisp, const u
     horizontalPath(cost, width, paddedDisp, true, grey, pp, scratch, sum, false);
 }
 
+void horizontalRowsScalar(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
+                          const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
+    horizontalRowScalar(cost0, width, paddedDisp, grey0, pp, scratch, sum0, true);
+    horizontalRowScalar(cost1, width, paddedDisp, grey1, pp, scratch, sum1, true);
+}
+
 void addPathRowScalar(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
     const int stride = pathStride(paddedDisp);
     for (int x = 0; x < width; ++x)
@@ -154,7 +160,7 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", censusRowScalar, costScratchScalar, costRowScalar,
-                           pathRowScalar, horizontalRowScalar, addPathRowScalar, wtaRowScalar,
+                           pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
                            upWtaRowScalar};
     return k;
 }

@@ -274,18 +274,114 @@ struct HorizontalChain {
     }
 };
 
-void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
-                   uint8_t *, uint16_t *sum, bool initSum) {
-    const int chunks = paddedDisp / kLanes8;
+// The same chain with its previous pixel's costs in registers: the number of vectors per
+// pixel is a template argument (1 .. 8), so the loops unroll and nothing goes through
+// memory between two pixels of the chain.
+template <int Chunks>
+struct RegisterChain {
+    v_uint8 prev[Chunks];
+    int minPrev = 255, previousX = -1;
+
+    RegisterChain() {
+        for (auto &v : prev) v = vx_setall_u8(kCostInvalid);
+    }
+    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, const uint8_t *grey,
+                                                    const PathParams &pp, const v_uint8 &p1, uint16_t *sum,
+                                                    bool initSum) {
+        const v_uint8 invalid = vx_setall_u8(kCostInvalid);
+        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        v_uint8 cur[Chunks];
+        v_uint8 least = invalid;
+#pragma GCC unroll 8
+        for (int c = 0; c < Chunks; ++c) {
+            const v_uint8 below = v_extract<kLanes8 - 1>(c > 0 ? prev[c - 1] : invalid, prev[c]); // d - 1
+            const v_uint8 above = v_extract<1>(prev[c], c + 1 < Chunks ? prev[c + 1] : invalid);  // d + 1
+            const v_uint8 t = v_min(v_min(prev[c], v_min(below, above) + p1), jump);
+            cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
+            least = v_min(least, cur[c]);
+        }
+        minPrev = v_reduce_min(least);
+        previousX = x;
+#pragma GCC unroll 8
+        for (int c = 0; c < Chunks; ++c) {
+            prev[c] = cur[c];
+            v_uint16 lo, hi;
+            v_expand(cur[c], lo, hi);
+            uint16_t *s = s0 + c * kLanes8;
+            if (initSum) {
+                v_store(s, lo);
+                v_store(s + kLanes16, hi);
+            } else {
+                v_store(s, vx_load(s) + lo);
+                v_store(s + kLanes16, vx_load(s + kLanes16) + hi);
+            }
+        }
+    }
+};
+
+// Rows rows (1 or 2), each with both chains, all side by side; stored (initSum) or added.
+template <int Chunks, int Rows>
+void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
+                  const PathParams &pp, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    HorizontalChain forward, backward;
+    RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
         // Sums are exact (at most 8 x 255), so the order of the additions does not
         // matter; the first path to reach a pixel stores instead of adding.
-        forward.step(cost, chunks, paddedDisp, i, grey, pp, p1, sum, initSum && i <= xb);
-        backward.step(cost, chunks, paddedDisp, xb, grey, pp, p1, sum, initSum && xb > i);
+#pragma GCC unroll 2
+        for (int r = 0; r < Rows; ++r) forward[r].step(cost[r], paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+#pragma GCC unroll 2
+        for (int r = 0; r < Rows; ++r) backward[r].step(cost[r], paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
     }
+}
+
+// The generic chain, for more than 8 vectors per pixel (SSE2 / NEON with 256 disparities).
+template <int Rows>
+void horizontalAny(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
+                   const PathParams &pp, uint16_t *const *sum, bool initSum) {
+    const int chunks = paddedDisp / kLanes8;
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    HorizontalChain forward[Rows], backward[Rows];
+    for (int i = 0; i < width; ++i) {
+        const int xb = width - 1 - i;
+        for (int r = 0; r < Rows; ++r)
+            forward[r].step(cost[r], chunks, paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+        for (int r = 0; r < Rows; ++r)
+            backward[r].step(cost[r], chunks, paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
+    }
+}
+
+template <int Rows>
+void horizontal(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey, const PathParams &pp,
+                uint16_t *const *sum, bool initSum) {
+    switch (paddedDisp / kLanes8) {
+    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    }
+}
+
+void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
+                   uint8_t *, uint16_t *sum, bool initSum) {
+    horizontal<1>(&cost, width, paddedDisp, &grey, pp, &sum, initSum);
+}
+
+void horizontalRows(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
+                    const uint8_t *grey1, const PathParams &pp, uint8_t *, uint16_t *sum0, uint16_t *sum1) {
+    const uint8_t *cost[2] = {cost0, cost1}, *grey[2] = {grey0, grey1};
+    uint16_t *sum[2] = {sum0, sum1};
+    horizontal<2>(cost, width, paddedDisp, grey, pp, sum, true);
 }
 
 void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
@@ -413,7 +509,7 @@ void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pa
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, addPathRow, wtaRow, upWtaRow};
+    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
     return k;
 }
 
