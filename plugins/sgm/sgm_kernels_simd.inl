@@ -410,7 +410,7 @@ struct Divider {
 };
 
 // One pixel's winner takes all, its least sum m already known.
-inline void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
                      uint16_t *bestSum, uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
     // One more pass finds the lowest d holding the least sum and counts the sums below
@@ -462,9 +462,13 @@ void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, 
 // The pass up of 4 paths, fused (sgm_kernels.hpp): per pixel the vertical path from
 // below, the sums of the four paths in a buffer that stays in L1 (nothing 16-bit is
 // stored to the row), their minimum on the way, then the winner takes all.
-void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+// Chunks: vectors per pixel (paddedDisp / kLanes8) when known at compile time (the loop
+// over the disparities unrolls), 0 when not.
+template <int Chunks>
+void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
     const int stride = pathStride(paddedDisp);
     const int whole = wp.numDisp / kLanes16 * kLanes16;
     const Divider divide(100 - wp.uniquenessPercent);
@@ -483,6 +487,7 @@ void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pa
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
         const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+#pragma GCC unroll 8
         for (int d = 0; d < paddedDisp; d += kLanes8) {
             const uint8_t *q = prev + d;
             const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
@@ -503,6 +508,18 @@ void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pa
         int m = v_reduce_min(leastSum);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, local[d]);
         wtaPixel(local, m, x, wp, divide, best, bestSum, disparity16);
+    }
+}
+
+void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    switch (paddedDisp / kLanes8) {
+#define SGM_UP_WTA(n) \
+    case n: return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
+        SGM_UP_WTA(1) SGM_UP_WTA(2) SGM_UP_WTA(4) SGM_UP_WTA(8)
+#undef SGM_UP_WTA
+    default: return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
     }
 }
 
