@@ -221,8 +221,48 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
     }
 }
 
+// One path and no sums (the pass down of 4 paths), Chunks vectors per pixel: unrolled.
+template <int Chunks>
+void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint8_t *grey, const uint8_t *greyPrev,
+               const PathParams &pp) {
+    constexpr int paddedDisp = Chunks * kLanes8;
+    const int stride = pathStride(paddedDisp);
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    const int dx = paths.dx[0];
+    for (int x = 0; x < width; ++x) {
+        const int xp = x + dx;
+        const bool has = paths.prevL[0] && xp >= 0 && xp < width;
+        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+        const int minPrev = has ? paths.prevMin[0][xp] : 255;
+        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        v_uint8 least = vx_setall_u8(255);
+#pragma GCC unroll 8
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const uint8_t *q = prev + d;
+            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+            v_store(out + d, l);
+            least = v_min(least, l);
+        }
+        paths.curMin[0][x] = v_reduce_min(least);
+    }
+}
+
 void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
              const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+    if (paths.count == 1 && !sum) {
+        switch (paddedDisp / kLanes8) {
+        case 1: return onePathOf<1>(cost, width, paths, grey, greyPrev, pp);
+        case 2: return onePathOf<2>(cost, width, paths, grey, greyPrev, pp);
+        case 4: return onePathOf<4>(cost, width, paths, grey, greyPrev, pp);
+        case 8: return onePathOf<8>(cost, width, paths, grey, greyPrev, pp);
+        default: break;
+        }
+    }
     if (paths.count == 1) pathRowOf<1>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
     else if (paths.count == 2) pathRowOf<2>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
     else pathRowOf<kMaxRowPaths>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
