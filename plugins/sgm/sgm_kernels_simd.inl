@@ -464,8 +464,10 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
     // would be mispredicted at every other pixel): the lowest match is the last kept.
     for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
         const v_uint16 v = vx_load(s + d);
-        const unsigned eq = static_cast<unsigned>(v_signmask(v == vm));
-        b = eq != 0 ? d + __builtin_ctz(eq) : b;
+        // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
+        // the 16-bit mask takes a pack and a permute first.
+        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
+        b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
         counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
     }
     int below = static_cast<int>(v_reduce_sum(counts));
