@@ -470,7 +470,9 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
         counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
     }
-    int below = static_cast<int>(v_reduce_sum(counts));
+    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
+    // bytes (one sum of absolute differences) is the sum of the lanes.
+    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
     for (int d = whole; d < wp.numDisp; ++d) {
         if (b < 0 && s[d] == m) b = d;
         below += s[d] < threshold;
