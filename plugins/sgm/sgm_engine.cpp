@@ -44,7 +44,7 @@ double Engine::workingBytes(int width, int height) const {
     // 8-bit costs, and the 16-bit sums (8 paths) or the 8-bit vertical path (4 paths).
     const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
-    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 2 /* scratch sums */ + 8 * w +
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 4 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
     return volume + images + std::max(1, settings_.stripes) * stripe;
 }
@@ -79,7 +79,7 @@ void Engine::prepare(int width, int height) {
         s.pathRows.assign(6 * w * ds, kCostInvalid);
         s.pathMins.assign(6 * w, 0);
         s.horizontal.assign(2 * ds, kCostInvalid);
-        s.scratchSum.assign(w * dp, 0);
+        s.scratchSum.assign(2 * w * dp, 0); // two rows: the horizontal paths run two at once
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
         s.rightBest.assign(w, -1);
@@ -121,11 +121,9 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
 // derives it, from the same sums); a left pixel whose disparity differs from its right
 // match's by more than disp12_max_diff is invalid (occluded or mismatched).
 void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
-    const WtaParams wp{settings_.minDisparity, settings_.numDisparities, paddedDisp_, settings_.uniquenessPercent,
-                       settings_.subpixel};
-    uint16_t *out = fixed_.ptr<uint16_t>(y);
-    kernels_.wtaRow(sum, width_, wp, s.best.data(), s.bestSum.data(), out);
+    if (sum) kernels_.wtaRow(sum, width_, wtaParams(), s.best.data(), s.bestSum.data(), fixed_.ptr<uint16_t>(y));
     if (settings_.disp12MaxDiff < 0) return;
+    uint16_t *out = fixed_.ptr<uint16_t>(y);
     std::fill(s.rightBest.begin(), s.rightBest.end(), -1);
     std::fill(s.rightSum.begin(), s.rightSum.end(), 0xFFFF);
     for (int x = 0; x < width_; ++x) {
@@ -160,7 +158,7 @@ void Engine::matchStripe(int index, int y0, int y1) {
 
     const uint8_t *prevRowL[kMaxRowPaths] = {};
     auto run = [&](const std::vector<int> &dxs, int yFirst, int yLast, int step, bool down) {
-        int parity = 0;
+        int parity = 0, pairedRow = -1;
         for (int y = yFirst;; y += step) {
             const bool own = y >= y0 && y < y1;
             const uint8_t *cost = costRow(s, y, own, down);
@@ -168,9 +166,23 @@ void Engine::matchStripe(int index, int y0, int y1) {
             uint16_t *sum = nullptr;
             if (own && keepDownPath_) {
                 if (!down) { // the horizontal paths first, then this pass's and the kept vertical
-                    sum = s.scratchSum.data();
-                    kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
-                                           s.horizontal.data(), sum, true);
+                    // Those of two rows at once (four serial chains side by side, whose
+                    // latencies overlap): this one's, and the next one's for the next step.
+                    uint16_t *second = s.scratchSum.data() + w * paddedDisp_;
+                    const int next = y + step;
+                    if (y == pairedRow) {
+                        sum = second;
+                    } else if (y != yLast && next >= y0 && next < y1) {
+                        sum = s.scratchSum.data();
+                        kernels_.horizontalRows(cost, costRow(s, next, true, false), width_, paddedDisp_,
+                                                greyLeft_.ptr<uint8_t>(y), greyLeft_.ptr<uint8_t>(next), pp,
+                                                s.horizontal.data(), sum, second);
+                        pairedRow = next;
+                    } else {
+                        sum = s.scratchSum.data();
+                        kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
+                                               s.horizontal.data(), sum, true);
+                    }
                 }
             } else if (own) {
                 // The pass down stores the horizontal paths' sums; the rest add to them (the
@@ -193,9 +205,16 @@ void Engine::matchStripe(int index, int y0, int y1) {
                 rp.curMin[i] = pathMin(i, parity);
                 prevRowL[i] = rp.curL[i];
             }
-            kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
-            if (own && keepDownPath_ && !down) kernels_.addPathRow(downPathRow(y), width_, paddedDisp_, sum);
-            if (own && (down != twoPass_)) finishRow(s, sum, y);
+            if (own && keepDownPath_ && !down) {
+                // The vertical path, the sums and the winner in one kernel; then the check.
+                kernels_.upWtaRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp,
+                                  downPathRow(y), sum, wtaParams(), s.best.data(), s.bestSum.data(),
+                                  fixed_.ptr<uint16_t>(y));
+                finishRow(s, nullptr, y);
+            } else {
+                kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
+                if (own && (down != twoPass_)) finishRow(s, sum, y);
+            }
             parity ^= 1;
             if (y == yLast) break;
         }

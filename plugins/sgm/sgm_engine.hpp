@@ -65,7 +65,13 @@ private:
     // The costs of row y: computed into the stripe's row (or into the cost volume, for a
     // row of the stripe's own in the pass down), or read back from the volume.
     const uint8_t *costRow(Stripe &s, int y, bool own, bool down);
+    // The winner of each pixel of row y from its sums (none: already found by upWtaRow),
+    // then the left-right check.
     void finishRow(Stripe &s, const uint16_t *sum, int y);
+    WtaParams wtaParams() const {
+        return {settings_.minDisparity, settings_.numDisparities, paddedDisp_, settings_.uniquenessPercent,
+                settings_.subpixel};
+    }
     uint16_t *volumeRow(int y) { return volume_.data() + static_cast<size_t>(y) * width_ * paddedDisp_; }
     uint8_t *downPathRow(int y) {
         return downPath_.data() + static_cast<size_t>(y) * width_ * pathStride(paddedDisp_);

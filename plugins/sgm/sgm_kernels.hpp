@@ -75,6 +75,12 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
 
+// Both horizontal paths of two rows (costs cost0 and cost1, intensities grey0 and grey1),
+// stored to sum0 and sum1: horizontalRow with initSum for each, run side by side.
+using HorizontalRowsFn = void (*)(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp,
+                                  const uint8_t *grey0, const uint8_t *grey1, const PathParams &pp, uint8_t *scratch,
+                                  uint16_t *sum0, uint16_t *sum1);
+
 // Adds one stored path row (the path-row layout above) to a row of sums: the pass up of
 // 4 paths adds the pass down's vertical path, kept as 8-bit costs.
 using AddPathRowFn = void (*)(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum);
@@ -95,6 +101,14 @@ struct WtaParams {
 using WtaRowFn = void (*)(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
                           uint16_t *disparity16);
 
+// The pass up of 4 paths, the last kernel of a row, fused: the vertical path from below
+// (as pathRow with paths.count == 1 and dx 0), whose costs are added to the sums of the
+// horizontal paths (sum, read only) together with the pass down's kept vertical path
+// (keptPath, as addPathRow), then the winner takes all over those sums (as wtaRow).
+using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                            const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+                            const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16);
+
 struct Kernels {
     const char *name;
     CensusRowFn censusRow;
@@ -102,8 +116,10 @@ struct Kernels {
     CostRowFn costRow;
     PathRowFn pathRow;
     HorizontalRowFn horizontalRow;
+    HorizontalRowsFn horizontalRows;
     AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
+    UpWtaRowFn upWtaRow;
 };
 
 const Kernels &scalarKernels();
@@ -111,6 +127,9 @@ const Kernels &scalarKernels();
 const Kernels *baselineKernels();
 // AVX2 (x86-64 only); NULL when not built in or when this CPU lacks AVX2.
 const Kernels *avx2Kernels();
+// AVX2 with AVX-512 VPOPCNTDQ and VL for the costs (x86-64 only); NULL when not built
+// in or when this CPU lacks them.
+const Kernels *avx512Kernels();
 // The fastest table this CPU runs.
 const Kernels &bestKernels();
 

@@ -17,6 +17,9 @@ const Kernels *baselineKernels() {
 #if defined(SGM_BUILD_AVX2)
 const Kernels *avx2Table(); // sgm_kernels_avx2.cpp
 #endif
+#if defined(SGM_BUILD_AVX512)
+const Kernels *avx512Table(); // sgm_kernels_avx512.cpp
+#endif
 
 // The CPU check lives here, in code built for the baseline: the AVX2 file may use AVX2
 // anywhere, so nothing of it runs before this says yes.
@@ -30,7 +33,18 @@ const Kernels *avx2Kernels() {
 #endif
 }
 
+const Kernels *avx512Kernels() {
+#if defined(SGM_BUILD_AVX512)
+    static const bool supported = avx2Kernels() && __builtin_cpu_supports("avx512vl") &&
+                                  __builtin_cpu_supports("avx512vpopcntdq");
+    return supported ? avx512Table() : nullptr;
+#else
+    return nullptr;
+#endif
+}
+
 const Kernels &bestKernels() {
+    if (const Kernels *k = avx512Kernels()) return *k;
     if (const Kernels *k = avx2Kernels()) return *k;
     if (const Kernels *k = baselineKernels()) return *k;
     return scalarKernels();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <iterator>
+#include <vector>
 
 namespace sgm {
 namespace {
@@ -108,6 +109,12 @@ void horizontalRowScalar(const uint8_t *cost, int width, int paddedDisp, const u
     horizontalPath(cost, width, paddedDisp, true, grey, pp, scratch, sum, false);
 }
 
+void horizontalRowsScalar(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
+                          const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
+    horizontalRowScalar(cost0, width, paddedDisp, grey0, pp, scratch, sum0, true);
+    horizontalRowScalar(cost1, width, paddedDisp, grey1, pp, scratch, sum1, true);
+}
+
 void addPathRowScalar(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
     const int stride = pathStride(paddedDisp);
     for (int x = 0; x < width; ++x)
@@ -138,11 +145,23 @@ void wtaRowScalar(const uint16_t *sum, int width, const WtaParams &wp, int16_t *
     }
 }
 
+// The three kernels it fuses, one after the other, on a copy of the sums.
+void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+                    const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+                    const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    thread_local std::vector<uint16_t> sums; // grows once: no allocation per frame after the first
+    sums.assign(sum, sum + static_cast<size_t>(width) * paddedDisp);
+    pathRowScalar(cost, width, paddedDisp, paths, grey, greyPrev, pp, sums.data(), false);
+    addPathRowScalar(keptPath, width, paddedDisp, sums.data());
+    wtaRowScalar(sums.data(), width, wp, best, bestSum, disparity16);
+}
+
 } // namespace
 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", censusRowScalar, costScratchScalar, costRowScalar,
-                           pathRowScalar, horizontalRowScalar, addPathRowScalar, wtaRowScalar};
+                           pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
+                           upWtaRowScalar};
     return k;
 }
 

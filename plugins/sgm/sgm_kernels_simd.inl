@@ -31,6 +31,17 @@ static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole 
 
 inline int addSat(int a, int b) { return a + b > 255 ? 255 : a + b; }
 
+// Bits set in each 64-bit lane. OpenCV's 256-bit v_popcount takes two byte-table lookups
+// and a sum of absolute differences; a CPU with AVX-512 VPOPCNTDQ counts them in one
+// instruction (the avx512 table, sgm_kernels_avx512.cpp, the same 256-bit code otherwise).
+inline v_uint64 popcount64(const v_uint64 &a) {
+#if defined(SGM_SIMD_VPOPCNT)
+    return v_uint64(_mm256_popcnt_epi64(a.val));
+#else
+    return v_popcount(a);
+#endif
+}
+
 // ---- census ---------------------------------------------------------------------------
 // kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
 // byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
@@ -103,6 +114,9 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
             plane[q] = j < static_cast<size_t>(width) ? right[width - 1 - j] : 0;
         }
     }
+    // planes[s]: plane s mod 8, one word further on for s >= 8.
+    const uint64_t *planes[16];
+    for (int s = 0; s < 16; ++s) planes[s] = scratch + (s & 7) * words + (s >> 3);
     alignas(64) uint8_t iotaBytes[kLanes8];
     for (int i = 0; i < kLanes8; ++i) iotaBytes[i] = static_cast<uint8_t>(i);
     const v_uint8 iota = vx_load_aligned(iotaBytes);
@@ -114,14 +128,16 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
         const int valid = std::min(numDisp, x - minD + 1);
         uint8_t *out = cost + static_cast<size_t>(x) * paddedDisp;
         for (int d0 = 0; d0 < paddedDisp; d0 += kLanes8) {
-            const int at = base + d0, q = at >> 3, r = at & 7;
-            v_uint64 word = vx_setzero_u64();
-            for (int k = 0; k < 8; ++k) {
-                const int s = r + k;
-                const uint64_t *plane = scratch + (s & 7) * words + q + (s >> 3);
-                word = word | (v_popcount(vx_load(plane) ^ centre) << (8 * k));
-            }
-            v_uint8 c = v_reinterpret_as_u8(word);
+            const int at = base + d0, q = at >> 3;
+            const uint64_t *const *p = planes + (at & 7);
+            // Written out: constant shifts, and two independent halves.
+            const v_uint64 w0 = popcount64(vx_load(p[0] + q) ^ centre) | v_shl<8>(popcount64(vx_load(p[1] + q) ^ centre)) |
+                                v_shl<16>(popcount64(vx_load(p[2] + q) ^ centre)) |
+                                v_shl<24>(popcount64(vx_load(p[3] + q) ^ centre));
+            const v_uint64 w1 = popcount64(vx_load(p[4] + q) ^ centre) | v_shl<8>(popcount64(vx_load(p[5] + q) ^ centre)) |
+                                v_shl<16>(popcount64(vx_load(p[6] + q) ^ centre)) |
+                                v_shl<24>(popcount64(vx_load(p[7] + q) ^ centre));
+            v_uint8 c = v_reinterpret_as_u8(w0 | v_shl<32>(w1));
             const int lanes = valid - d0;
             if (lanes < kLanes8) c = v_select(iota < vx_setall_u8(static_cast<uint8_t>(lanes > 0 ? lanes : 0)), c, invalid);
             v_store(out + d0, c);
@@ -144,10 +160,11 @@ const uint8_t *freshPath() {
 // L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + P1, min L(q) + P2) - min L(q) for the
 // paths of a row side by side, pixel by pixel, so that the 16-bit sums are read and
 // written once per pixel whatever the number of paths.
-void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+// The number of paths is a template argument: the per-path vectors stay in registers.
+template <int n>
+void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+               const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
     const int stride = pathStride(paddedDisp);
-    const int n = paths.count;
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     for (int x = 0; x < width; ++x) {
         const uint8_t *prev[kMaxRowPaths];
@@ -204,6 +221,53 @@ void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pat
     }
 }
 
+// One path and no sums (the pass down of 4 paths), Chunks vectors per pixel: unrolled.
+template <int Chunks>
+void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint8_t *grey, const uint8_t *greyPrev,
+               const PathParams &pp) {
+    constexpr int paddedDisp = Chunks * kLanes8;
+    const int stride = pathStride(paddedDisp);
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    const int dx = paths.dx[0];
+    for (int x = 0; x < width; ++x) {
+        const int xp = x + dx;
+        const bool has = paths.prevL[0] && xp >= 0 && xp < width;
+        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(xp) * stride + 1 : freshPath();
+        const int minPrev = has ? paths.prevMin[0][xp] : 255;
+        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        v_uint8 least = vx_setall_u8(255);
+#pragma GCC unroll 8
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const uint8_t *q = prev + d;
+            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+            v_store(out + d, l);
+            least = v_min(least, l);
+        }
+        paths.curMin[0][x] = v_reduce_min(least);
+    }
+}
+
+void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum) {
+    if (paths.count == 1 && !sum) {
+        switch (paddedDisp / kLanes8) {
+        case 1: return onePathOf<1>(cost, width, paths, grey, greyPrev, pp);
+        case 2: return onePathOf<2>(cost, width, paths, grey, greyPrev, pp);
+        case 4: return onePathOf<4>(cost, width, paths, grey, greyPrev, pp);
+        case 8: return onePathOf<8>(cost, width, paths, grey, greyPrev, pp);
+        default: break;
+        }
+    }
+    if (paths.count == 1) pathRowOf<1>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
+    else if (paths.count == 2) pathRowOf<2>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
+    else pathRowOf<kMaxRowPaths>(cost, width, paddedDisp, paths, grey, greyPrev, pp, sum, initSum);
+}
+
 // Both horizontal paths of a row, left to right and right to left, interleaved: each is
 // a serial chain (a pixel needs its predecessor's minimum), so running the two side by
 // side lets the CPU overlap their latencies. Each carries its previous pixel's costs in
@@ -250,18 +314,114 @@ struct HorizontalChain {
     }
 };
 
-void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
-                   uint8_t *, uint16_t *sum, bool initSum) {
-    const int chunks = paddedDisp / kLanes8;
+// The same chain with its previous pixel's costs in registers: the number of vectors per
+// pixel is a template argument (1 .. 8), so the loops unroll and nothing goes through
+// memory between two pixels of the chain.
+template <int Chunks>
+struct RegisterChain {
+    v_uint8 prev[Chunks];
+    int minPrev = 255, previousX = -1;
+
+    RegisterChain() {
+        for (auto &v : prev) v = vx_setall_u8(kCostInvalid);
+    }
+    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, const uint8_t *grey,
+                                                    const PathParams &pp, const v_uint8 &p1, uint16_t *sum,
+                                                    bool initSum) {
+        const v_uint8 invalid = vx_setall_u8(kCostInvalid);
+        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        v_uint8 cur[Chunks];
+        v_uint8 least = invalid;
+#pragma GCC unroll 8
+        for (int c = 0; c < Chunks; ++c) {
+            const v_uint8 below = v_extract<kLanes8 - 1>(c > 0 ? prev[c - 1] : invalid, prev[c]); // d - 1
+            const v_uint8 above = v_extract<1>(prev[c], c + 1 < Chunks ? prev[c + 1] : invalid);  // d + 1
+            const v_uint8 t = v_min(v_min(prev[c], v_min(below, above) + p1), jump);
+            cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
+            least = v_min(least, cur[c]);
+        }
+        minPrev = v_reduce_min(least);
+        previousX = x;
+#pragma GCC unroll 8
+        for (int c = 0; c < Chunks; ++c) {
+            prev[c] = cur[c];
+            v_uint16 lo, hi;
+            v_expand(cur[c], lo, hi);
+            uint16_t *s = s0 + c * kLanes8;
+            if (initSum) {
+                v_store(s, lo);
+                v_store(s + kLanes16, hi);
+            } else {
+                v_store(s, vx_load(s) + lo);
+                v_store(s + kLanes16, vx_load(s + kLanes16) + hi);
+            }
+        }
+    }
+};
+
+// Rows rows (1 or 2), each with both chains, all side by side; stored (initSum) or added.
+template <int Chunks, int Rows>
+void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
+                  const PathParams &pp, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    HorizontalChain forward, backward;
+    RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
         // Sums are exact (at most 8 x 255), so the order of the additions does not
         // matter; the first path to reach a pixel stores instead of adding.
-        forward.step(cost, chunks, paddedDisp, i, grey, pp, p1, sum, initSum && i <= xb);
-        backward.step(cost, chunks, paddedDisp, xb, grey, pp, p1, sum, initSum && xb > i);
+#pragma GCC unroll 2
+        for (int r = 0; r < Rows; ++r) forward[r].step(cost[r], paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+#pragma GCC unroll 2
+        for (int r = 0; r < Rows; ++r) backward[r].step(cost[r], paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
     }
+}
+
+// The generic chain, for more than 8 vectors per pixel (SSE2 / NEON with 256 disparities).
+template <int Rows>
+void horizontalAny(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
+                   const PathParams &pp, uint16_t *const *sum, bool initSum) {
+    const int chunks = paddedDisp / kLanes8;
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    HorizontalChain forward[Rows], backward[Rows];
+    for (int i = 0; i < width; ++i) {
+        const int xb = width - 1 - i;
+        for (int r = 0; r < Rows; ++r)
+            forward[r].step(cost[r], chunks, paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+        for (int r = 0; r < Rows; ++r)
+            backward[r].step(cost[r], chunks, paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
+    }
+}
+
+template <int Rows>
+void horizontal(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey, const PathParams &pp,
+                uint16_t *const *sum, bool initSum) {
+    switch (paddedDisp / kLanes8) {
+    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    }
+}
+
+void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
+                   uint8_t *, uint16_t *sum, bool initSum) {
+    horizontal<1>(&cost, width, paddedDisp, &grey, pp, &sum, initSum);
+}
+
+void horizontalRows(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
+                    const uint8_t *grey1, const PathParams &pp, uint8_t *, uint16_t *sum0, uint16_t *sum1) {
+    const uint8_t *cost[2] = {cost0, cost1}, *grey[2] = {grey0, grey1};
+    uint16_t *sum[2] = {sum0, sum1};
+    horizontal<2>(cost, width, paddedDisp, grey, pp, sum, true);
 }
 
 void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
@@ -279,49 +439,138 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 }
 
 // ---- winner takes all -----------------------------------------------------------------
+// q = floor(n / a) for 0 <= n < 2^23, 1 <= a <= 100, by a multiplication (no integer
+// division per pixel): with M = floor(2^40 / a) + 1 = (2^40 + e) / a, 0 < e <= a,
+// n * M / 2^40 = n / a + n * e / (a * 2^40), and n * e < 2^40 keeps the floor exact.
+struct Divider {
+    int a;
+    uint64_t m;
+    explicit Divider(int divisor) : a(divisor), m((uint64_t(1) << 40) / static_cast<uint64_t>(divisor) + 1) {}
+    int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
+};
+
+// One pixel's winner takes all, its least sum m already known.
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
+                     uint16_t *bestSum, uint16_t *disparity16) {
+    const int whole = wp.numDisp / kLanes16 * kLanes16;
+    // One more pass finds the lowest d holding the least sum and counts the sums below
+    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
+    const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
+    const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
+    const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
+    int b = -1;
+    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
+    // Backwards, without a branch on where the least sum lies (it is anywhere: a branch
+    // would be mispredicted at every other pixel): the lowest match is the last kept.
+    for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
+        const v_uint16 v = vx_load(s + d);
+        // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
+        // the 16-bit mask takes a pack and a permute first.
+        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
+        b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
+        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
+    }
+    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
+    // bytes (one sum of absolute differences) is the sum of the lanes.
+    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
+    for (int d = whole; d < wp.numDisp; ++d) {
+        if (b < 0 && s[d] == m) b = d;
+        below += s[d] < threshold;
+    }
+    bestSum[x] = static_cast<uint16_t>(m);
+    if (x - wp.minDisparity - b < 0) {
+        best[x] = -1;
+        disparity16[x] = 0;
+        return;
+    }
+    best[x] = static_cast<int16_t>(b);
+    // Those at b - 1, b, b + 1 do not count.
+    for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
+    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+}
+
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
             uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
+    const Divider divide(100 - wp.uniquenessPercent);
     for (int x = 0; x < width; ++x) {
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
         int m = v_reduce_min(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
-        // One more pass finds the lowest d holding the least sum and counts the sums below
-        // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
-        const int a = 100 - wp.uniquenessPercent;
-        const int threshold = std::min(65535, (m * 100 + a - 1) / a);
-        const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
-        const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
-        int b = -1, below = 0;
-        for (int d = 0; d < whole; d += kLanes16) {
-            const v_uint16 v = vx_load(s + d);
-            const unsigned eq = static_cast<unsigned>(v_signmask(v == vm));
-            if (b < 0 && eq != 0) b = d + __builtin_ctz(eq);
-            below += __builtin_popcount(static_cast<unsigned>(v_signmask(v < vt)));
+        wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
+    }
+}
+
+// The pass up of 4 paths, fused (sgm_kernels.hpp): per pixel the vertical path from
+// below, the sums of the four paths in a buffer that stays in L1 (nothing 16-bit is
+// stored to the row), their minimum on the way, then the winner takes all.
+// Chunks: vectors per pixel (paddedDisp / kLanes8) when known at compile time (the loop
+// over the disparities unrolls), 0 when not.
+template <int Chunks>
+void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPaths &paths, const uint8_t *grey,
+             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
+    const int stride = pathStride(paddedDisp);
+    const int whole = wp.numDisp / kLanes16 * kLanes16;
+    const Divider divide(100 - wp.uniquenessPercent);
+    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    alignas(64) uint16_t local[kDispAlign * 8];
+    for (int x = 0; x < width; ++x) {
+        const bool has = paths.prevL[0] != nullptr;
+        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(x) * stride + 1 : freshPath();
+        const int minPrev = has ? paths.prevMin[0][x] : 255;
+        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[x])] : pp.p2Lut[0];
+        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        v_uint8 least = vx_setall_u8(255);
+        v_uint16 leastSum = vx_setall_u16(0xFFFF);
+        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+        const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
+        const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+#pragma GCC unroll 8
+        for (int d = 0; d < paddedDisp; d += kLanes8) {
+            const uint8_t *q = prev + d;
+            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+            v_store(out + d, l);
+            least = v_min(least, l);
+            v_uint16 l0, l1, k0lo, k0hi;
+            v_expand(l, l0, l1);
+            v_expand(vx_load(k0 + d), k0lo, k0hi);
+            const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
+            const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
+            v_store(local + d, lo);
+            v_store(local + d + kLanes16, hi);
+            if (d < whole) leastSum = v_min(leastSum, lo);
+            if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
         }
-        for (int d = whole; d < wp.numDisp; ++d) {
-            if (b < 0 && s[d] == m) b = d;
-            below += s[d] < threshold;
-        }
-        bestSum[x] = static_cast<uint16_t>(m);
-        if (x - wp.minDisparity - b < 0) {
-            best[x] = -1;
-            disparity16[x] = 0;
-            continue;
-        }
-        best[x] = static_cast<int16_t>(b);
-        // Those at b - 1, b, b + 1 do not count.
-        for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
-        disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+        paths.curMin[0][x] = v_reduce_min(least);
+        int m = v_reduce_min(leastSum);
+        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, local[d]);
+        wtaPixel(local, m, x, wp, divide, best, bestSum, disparity16);
+    }
+}
+
+void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
+              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
+              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+    switch (paddedDisp / kLanes8) {
+#define SGM_UP_WTA(n) \
+    case n: return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
+        SGM_UP_WTA(1) SGM_UP_WTA(2) SGM_UP_WTA(4) SGM_UP_WTA(8)
+#undef SGM_UP_WTA
+    default: return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
     }
 }
 
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, addPathRow, wtaRow};
+    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
     return k;
 }
 

@@ -74,8 +74,8 @@ public:
                 .help("horizontal stripes matched in parallel (each warms its paths up on 16 rows of the next); the result depends on it, not on the thread count"),
             Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
                 .help("refuse a pair whose working memory (with 4 or 8 paths: width x height x num_disparities x 2 bytes and more) would exceed this"),
-            Param::choice("kernels", "auto", "auto|avx2|baseline|scalar")
-                .help("instruction set: auto (the fastest this CPU runs), avx2, baseline (SSE2 / NEON) or scalar (the reference)"),
+            Param::choice("kernels", "auto", "auto|avx512|avx2|baseline|scalar")
+                .help("instruction set: auto (the fastest this CPU runs), avx512 (avx2 with AVX-512 VPOPCNTDQ costs), avx2, baseline (SSE2 / NEON) or scalar (the reference)"),
         };
     }
 
@@ -162,6 +162,11 @@ private:
         if (name == "avx2") {
             if (const sgm::Kernels *k = sgm::avx2Kernels()) return *k;
             refuse("kernels = 'avx2': this CPU or this build has no AVX2; expected auto, baseline or scalar");
+        }
+        if (name == "avx512") {
+            if (const sgm::Kernels *k = sgm::avx512Kernels()) return *k;
+            refuse("kernels = 'avx512': this CPU or this build has no AVX-512 VPOPCNTDQ and VL; expected auto, avx2, "
+                   "baseline or scalar");
         }
         return sgm::bestKernels();
     }

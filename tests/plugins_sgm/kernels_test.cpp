@@ -22,12 +22,17 @@ std::vector<std::string> simdTables() {
     std::vector<std::string> t;
     if (sgm::baselineKernels()) t.push_back("baseline");
     if (sgm::avx2Kernels()) t.push_back("avx2");
+    if (sgm::avx512Kernels()) t.push_back("avx512");
     return t;
 }
 
 class SimdKernels : public ::testing::TestWithParam<std::string> {
 protected:
-    const Kernels &simd() const { return GetParam() == "avx2" ? *sgm::avx2Kernels() : *sgm::baselineKernels(); }
+    const Kernels &simd() const {
+        return GetParam() == "avx512" ? *sgm::avx512Kernels()
+               : GetParam() == "avx2" ? *sgm::avx2Kernels()
+                                      : *sgm::baselineKernels();
+    }
     const Kernels &ref() const { return sgm::scalarKernels(); }
     std::mt19937_64 rng{20};
     uint8_t byte() { return static_cast<uint8_t>(rng()); }
@@ -170,6 +175,69 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         ref().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sa.data(), init);
                         simd().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sb.data(), init);
                         ASSERT_EQ(sa, sb) << "horizontal, " << what;
+                    }
+}
+
+// The horizontal paths of two rows at once equal those of each row alone (stored sums).
+TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
+    for (int width : kWidths)
+        for (int numDisp : {16, 64, 96, 128, 256}) {
+            const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
+            const PathCase a = pathCase(rng, width, numDisp, p1, p2), b = pathCase(rng, width, numDisp, p1, p2);
+            const sgm::PathParams pp{p1, a.lut.data()};
+            std::vector<uint8_t> scratch(2 * sgm::pathStride(a.dp), sgm::kCostInvalid);
+            std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
+            ref().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
+                                 scratch.data(), ra0.data(), ra1.data());
+            simd().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
+                                  scratch.data(), rb0.data(), rb1.data());
+            const std::string what = "width " + std::to_string(width) + ", num_disparities " + std::to_string(numDisp);
+            ASSERT_EQ(ra0, rb0) << what;
+            ASSERT_EQ(ra1, rb1) << what;
+            ref().horizontalRow(a.cost.data(), width, a.dp, a.grey.data(), pp, scratch.data(), one.data(), true);
+            ASSERT_EQ(one, ra0) << "two rows against one, " << what;
+        }
+}
+
+// The fused pass up of 4 paths (vertical path, sums, winner) equals the kernels it fuses.
+TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
+    for (int width : kWidths)
+        for (int numDisp : {16, 48, 64, 96, 128, 256})
+            for (bool first : {false, true})
+                for (int uniqueness : {0, 10, 60})
+                    for (bool subpixel : {false, true}) {
+                        const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
+                        const PathCase c = pathCase(rng, width, numDisp, p1, p2);
+                        const PathCase kept = pathCase(rng, width, numDisp, p1, p2);
+                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const int minD = uniqueness == 10 ? 5 : 0;
+                        const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
+                        const size_t w = static_cast<size_t>(width);
+                        std::vector<uint8_t> la(w * sgm::pathStride(c.dp), sgm::kCostInvalid), lb = la;
+                        std::vector<uint8_t> ma(w), mb(w);
+                        sgm::RowPaths ra{}, rb{};
+                        ra.count = rb.count = 1;
+                        ra.prevL[0] = rb.prevL[0] = first ? nullptr : c.prevL.data();
+                        ra.prevMin[0] = rb.prevMin[0] = c.prevMin.data();
+                        ra.curL[0] = la.data();
+                        rb.curL[0] = lb.data();
+                        ra.curMin[0] = ma.data();
+                        rb.curMin[0] = mb.data();
+                        std::vector<int16_t> ba(w), bb(w);
+                        std::vector<uint16_t> sa(w), sb(w), da(w), db(w);
+                        const std::vector<uint16_t> sum = c.sum;
+                        ref().upWtaRow(c.cost.data(), width, c.dp, ra, c.grey.data(), c.greyPrev.data(), pp,
+                                       kept.prevL.data(), sum.data(), wp, ba.data(), sa.data(), da.data());
+                        simd().upWtaRow(c.cost.data(), width, c.dp, rb, c.grey.data(), c.greyPrev.data(), pp,
+                                        kept.prevL.data(), sum.data(), wp, bb.data(), sb.data(), db.data());
+                        const std::string what = "width " + std::to_string(width) + ", num_disparities " +
+                                                 std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
+                        ASSERT_EQ(la, lb) << what;
+                        ASSERT_EQ(ma, mb) << what;
+                        ASSERT_EQ(ba, bb) << what;
+                        ASSERT_EQ(sa, sb) << what;
+                        ASSERT_EQ(da, db) << what;
+                        ASSERT_EQ(sum, c.sum) << "the horizontal sums are read only, " << what;
                     }
 }
 
