@@ -53,20 +53,9 @@ inline std::vector<binocle_param_desc> withSharedMatcherParameters(std::vector<b
     return all;
 }
 
-inline std::string pixelFormatName(int32_t format) {
-    switch (format) {
-    case BINOCLE_PIXEL_GRAY8: return "GRAY8";
-    case BINOCLE_PIXEL_GRAY16: return "GRAY16";
-    case BINOCLE_PIXEL_BGR8: return "BGR8";
-    case BINOCLE_PIXEL_RGB8: return "RGB8";
-    case BINOCLE_PIXEL_FLOAT32: return "FLOAT32";
-    default: return "unknown format " + std::to_string(format);
-    }
-}
-
-inline std::string sizeText(const binocle_image &im) {
-    return std::to_string(im.width) + "x" + std::to_string(im.height);
-}
+using sdk::checkMatcherImages;
+using sdk::pixelFormatName;
+using sdk::sizeText;
 
 // A cv::Mat header on the image's pixels (no copy), honouring its stride.
 inline cv::Mat wrapImage(const binocle_image &im) {
@@ -83,40 +72,6 @@ inline cv::Mat wrapImage(const binocle_image &im) {
     return cv::Mat(im.height, im.width, type, im.data, static_cast<size_t>(im.stride_bytes));
 }
 
-// Throws unless `im` is a usable view: positive size, data, stride covering a row.
-inline void checkImage(const binocle_image &im, const std::string &role) {
-    if (im.width <= 0 || im.height <= 0)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image is " + sizeText(im) + ": expected a positive size");
-    if (!im.data) throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image has no pixels (data is NULL)");
-    const int64_t row = static_cast<int64_t>(im.width) * sdk::bytesPerPixel(im.format);
-    if (im.stride_bytes < row)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image stride is " + std::to_string(im.stride_bytes) +
-                                                           " bytes: expected at least " + std::to_string(row) +
-                                                           " (width x bytes per pixel)");
-}
-
-// Checks a matcher's arguments as the ABI states them (matcher.h).
-inline void checkMatcherImages(const binocle_image &left, const binocle_image &right, const binocle_image &disparity) {
-    if (left.format != BINOCLE_PIXEL_GRAY8 && left.format != BINOCLE_PIXEL_BGR8 && left.format != BINOCLE_PIXEL_RGB8)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                         "left image is " + pixelFormatName(left.format) + ": expected GRAY8, BGR8 or RGB8");
-    if (right.format != left.format)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "right image is " + pixelFormatName(right.format) +
-                                                           ": expected " + pixelFormatName(left.format) +
-                                                           ", the format of the left image");
-    if (right.width != left.width || right.height != left.height)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "right image is " + sizeText(right) + ": expected " +
-                                                           sizeText(left) + ", the size of the left image");
-    if (disparity.format != BINOCLE_PIXEL_FLOAT32)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                         "disparity image is " + pixelFormatName(disparity.format) + ": expected FLOAT32");
-    if (disparity.width != left.width || disparity.height != left.height)
-        throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, "disparity image is " + sizeText(disparity) + ": expected " +
-                                                           sizeText(left) + ", the size of the left image");
-    checkImage(left, "left");
-    checkImage(right, "right");
-    checkImage(disparity, "disparity");
-}
 
 // The image as 8-bit grey: a view of its pixels when already GRAY8, else converted
 // into `buffer` (reused from call to call).

@@ -27,18 +27,7 @@ std::string number(double v) {
     return s.str();
 }
 
-std::string formatName(int32_t format) {
-    switch (format) {
-    case BINOCLE_PIXEL_GRAY8: return "GRAY8";
-    case BINOCLE_PIXEL_GRAY16: return "GRAY16";
-    case BINOCLE_PIXEL_BGR8: return "BGR8";
-    case BINOCLE_PIXEL_RGB8: return "RGB8";
-    case BINOCLE_PIXEL_FLOAT32: return "FLOAT32";
-    default: return "unknown format " + std::to_string(format);
-    }
-}
-
-std::string sizeText(const binocle_image &im) { return std::to_string(im.width) + "x" + std::to_string(im.height); }
+using binocle::sdk::sizeText;
 
 [[noreturn]] void refuse(const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "sgm: " + what); }
 
@@ -114,7 +103,7 @@ public:
     }
 
     void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) override {
-        checkImages(left, right, disparity);
+        binocle::sdk::checkMatcherImages(left, right, disparity, "sgm: ");
         try {
             cv::Mat out(disparity.height, disparity.width, CV_32FC1, disparity.data,
                         static_cast<size_t>(disparity.stride_bytes));
@@ -169,29 +158,6 @@ private:
                    "baseline or scalar");
         }
         return sgm::bestKernels();
-    }
-
-    // The ABI's promises (matcher.h), checked: a host never sends anything else.
-    static void checkImages(const binocle_image &left, const binocle_image &right, const binocle_image &disparity) {
-        if (left.format != BINOCLE_PIXEL_GRAY8 && left.format != BINOCLE_PIXEL_BGR8 && left.format != BINOCLE_PIXEL_RGB8)
-            refuse("left image is " + formatName(left.format) + ": expected GRAY8, BGR8 or RGB8");
-        if (right.format != left.format)
-            refuse("right image is " + formatName(right.format) + ": expected " + formatName(left.format) + ", the left image's format");
-        if (right.width != left.width || right.height != left.height)
-            refuse("right image is " + sizeText(right) + ": expected " + sizeText(left) + ", the left image's size");
-        if (disparity.format != BINOCLE_PIXEL_FLOAT32)
-            refuse("disparity image is " + formatName(disparity.format) + ": expected FLOAT32");
-        if (disparity.width != left.width || disparity.height != left.height)
-            refuse("disparity image is " + sizeText(disparity) + ": expected " + sizeText(left) + ", the left image's size");
-        const std::pair<const binocle_image *, const char *> all[] = {{&left, "left"}, {&right, "right"}, {&disparity, "disparity"}};
-        for (const auto &[im, role] : all) {
-            if (im->width <= 0 || im->height <= 0) refuse(std::string(role) + " image is " + sizeText(*im) + ": expected a positive size");
-            if (!im->data) refuse(std::string(role) + " image has no pixels (data is NULL)");
-            const int64_t row = static_cast<int64_t>(im->width) * binocle::sdk::bytesPerPixel(im->format);
-            if (im->stride_bytes < row)
-                refuse(std::string(role) + " image stride is " + std::to_string(im->stride_bytes) + " bytes: expected at least " +
-                       std::to_string(row) + " (width x bytes per pixel)");
-        }
     }
 
     // 8-bit grey: a view of the pixels when already GRAY8, else converted into `buffer`.

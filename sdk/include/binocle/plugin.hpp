@@ -161,6 +161,62 @@ inline binocle_image makeImage(int32_t width, int32_t height, int32_t format, vo
     return im;
 }
 
+// "GRAY8", ... for messages.
+inline std::string pixelFormatName(int32_t format) {
+    switch (format) {
+    case BINOCLE_PIXEL_GRAY8: return "GRAY8";
+    case BINOCLE_PIXEL_GRAY16: return "GRAY16";
+    case BINOCLE_PIXEL_BGR8: return "BGR8";
+    case BINOCLE_PIXEL_RGB8: return "RGB8";
+    case BINOCLE_PIXEL_FLOAT32: return "FLOAT32";
+    default: return "unknown format " + std::to_string(format);
+    }
+}
+
+// "640x480", for messages.
+inline std::string sizeText(const binocle_image &im) {
+    return std::to_string(im.width) + "x" + std::to_string(im.height);
+}
+
+// Throws (BINOCLE_ERR_INVALID_ARGUMENT) unless `im` is a usable view: positive size, data,
+// stride covering a row. `role` names it: "left", "disparity".
+inline void checkImage(const binocle_image &im, const std::string &role) {
+    if (im.width <= 0 || im.height <= 0)
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image is " + sizeText(im) + ": expected a positive size");
+    if (!im.data) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image has no pixels (data is NULL)");
+    const int64_t row = static_cast<int64_t>(im.width) * bytesPerPixel(im.format);
+    if (im.stride_bytes < row)
+        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, role + " image stride is " + std::to_string(im.stride_bytes) +
+                                                      " bytes: expected at least " + std::to_string(row) +
+                                                      " (width x bytes per pixel)");
+}
+
+// A matcher's arguments checked as the ABI states them (matcher.h): left GRAY8, BGR8 or
+// RGB8; right the same format and size; disparity FLOAT32 of that size; all usable views.
+// `prefix` starts each message ("sgm: ").
+inline void checkMatcherImages(const binocle_image &left, const binocle_image &right, const binocle_image &disparity,
+                               const std::string &prefix = "") {
+    auto refuse = [&](const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, prefix + what); };
+    if (left.format != BINOCLE_PIXEL_GRAY8 && left.format != BINOCLE_PIXEL_BGR8 && left.format != BINOCLE_PIXEL_RGB8)
+        refuse("left image is " + pixelFormatName(left.format) + ": expected GRAY8, BGR8 or RGB8");
+    if (right.format != left.format)
+        refuse("right image is " + pixelFormatName(right.format) + ": expected " + pixelFormatName(left.format) +
+               ", the format of the left image");
+    if (right.width != left.width || right.height != left.height)
+        refuse("right image is " + sizeText(right) + ": expected " + sizeText(left) + ", the size of the left image");
+    if (disparity.format != BINOCLE_PIXEL_FLOAT32)
+        refuse("disparity image is " + pixelFormatName(disparity.format) + ": expected FLOAT32");
+    if (disparity.width != left.width || disparity.height != left.height)
+        refuse("disparity image is " + sizeText(disparity) + ": expected " + sizeText(left) + ", the size of the left image");
+    try {
+        checkImage(left, "left");
+        checkImage(right, "right");
+        checkImage(disparity, "disparity");
+    } catch (const Error &e) {
+        refuse(e.what());
+    }
+}
+
 // ---- StereoSource ----------------------------------------------------------------------
 
 // A frame a C++ source hands out. The SDK lends it to the host and destroys it when
