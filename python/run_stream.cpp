@@ -2,7 +2,12 @@
 // The run's thread and the bounded queue between the pipeline's writer stage and Python.
 #include "python/run_stream.hpp"
 
+#include "core/atomic_file.hpp"
+
+#include <filesystem>
 #include <spdlog/spdlog.h>
+
+namespace fs = std::filesystem;
 
 namespace binocle::python {
 
@@ -39,6 +44,14 @@ void RunStream::work() {
         summary = pipeline_->run(options, [this](const FrameResult &r) { onFrame(r); });
     } catch (...) {
         error = std::current_exception();
+        // A failed run throws after writing its summary: with an output folder, that is
+        // the summary the caller sees.
+        if (!options_.out_dir.empty()) {
+            try {
+                summary = nlohmann::ordered_json::parse(readTextFile((fs::path(options_.out_dir) / "summary.json").string()));
+            } catch (const std::exception &) {
+            }
+        }
     }
     std::lock_guard<std::mutex> lock(mutex_);
     summary_ = std::move(summary);

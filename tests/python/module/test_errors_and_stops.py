@@ -139,3 +139,17 @@ def test_a_taken_output_folder_is_refused(tmp_path):
         next(first)
         with pytest.raises(binocle.Error):
             rig.run(out=str(tmp_path))
+
+
+def test_a_failed_run_raises_the_cli_message_after_its_summary(tmp_path):
+    bad = tmp_path / "not-an-image.png"
+    bad.write_text("not a png")
+    sets = {"source.left": str(bad), "source.right": str(bad), "source.ground_truth": ""}
+    status, _, err = cli("run", ALOE, "--quiet", *[f"--set={k}={v}" for k, v in sets.items()], check=False)
+    assert status == 1
+    run = binocle.Rig(ALOE, set=sets).run(out=str(tmp_path / "out"))
+    with pytest.raises(binocle.Error) as e:
+        list(run)
+    assert str(e.value) == cli_error(err, "run")
+    assert "cannot decode" in str(e.value)
+    assert run.summary["status"] == "failed" == read_json(str(tmp_path / "out" / "summary.json"))["status"]
