@@ -15,7 +15,11 @@
 
 #include <pybind11/stl.h>
 
+#include <condition_variable>
 #include <cstdlib>
+#include <mutex>
+#include <optional>
+#include <thread>
 #include <filesystem>
 
 namespace py = pybind11;
@@ -171,7 +175,41 @@ py::dict experiment(const std::string &file, const py::object &set, const py::ob
         options.replace = force;
         options.only = tests;
         const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, force, "binocle.experiment"});
-        result = runExperiment(e, host, options);
+        // The tests run on a thread of their own, so that this one sees Ctrl-C: no further
+        // test starts, the tables say "interrupted", then the KeyboardInterrupt goes on.
+        std::atomic<bool> stop{false};
+        options.stop = &stop;
+        std::exception_ptr error;
+        std::mutex mutex;
+        std::condition_variable ended;
+        bool done = false;
+        std::thread worker([&] {
+            try {
+                result = runExperiment(e, host, options);
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(mutex);
+            done = true;
+            ended.notify_all();
+        });
+        std::optional<py::error_already_set> interrupt;
+        for (std::unique_lock<std::mutex> lock(mutex); !ended.wait_for(lock, kSignalPoll, [&] { return done; });) {
+            if (interrupt || stop) continue;
+            lock.unlock();
+            py::gil_scoped_acquire acquire;
+            if (PyErr_CheckSignals() != 0) {
+                interrupt.emplace();
+                stop = true;
+            }
+            lock.lock();
+        }
+        worker.join();
+        if (interrupt) {
+            py::gil_scoped_acquire acquire;
+            throw *interrupt;
+        }
+        if (error) std::rethrow_exception(error);
     }
     // What the command wrote, as data: results.json (rows under "tests", with their
     // per-repeat details), plus where it lies and the run's own counts.

@@ -3,6 +3,8 @@
 # `binocle experiment` writes.
 import os
 import re
+import signal
+import threading
 
 import pytest
 
@@ -59,3 +61,18 @@ def test_experiment_errors_have_the_cli_message(tmp_path):
     with pytest.raises(binocle.Error) as e:
         binocle.experiment(e1, set={"repeats": 0}, out=str(tmp_path))
     assert str(e.value) in err
+
+
+def test_keyboard_interrupt_stops_an_experiment_between_tests(tmp_path):
+    e1 = os.path.join(ROOT, "configs", "experiments", "e1.yaml")
+    pid = os.getpid()
+    timer = threading.Timer(0.5, lambda: os.kill(pid, signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            binocle.experiment(e1, out=str(tmp_path), tests=["1", "2", "3", "4", "5", "6", "7", "8"])
+    finally:
+        timer.cancel()
+    written = read_json(str(tmp_path / "results.json"))
+    assert written["status"] == "interrupted"
+    assert len(written["tests"]) < 8
