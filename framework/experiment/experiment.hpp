@@ -10,6 +10,7 @@
 #include "host/plugin_host.hpp"
 #include "method/design.hpp"
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <optional>
@@ -122,6 +123,9 @@ struct ExperimentOptions {
     // --force: replace another experiment's results in out_dir (this experiment's own are
     // replaced by a run of every test anyway; a partial run never replaces a table).
     bool replace = false;
+    // Polled before each test: once true, no further test starts and the tables keep the
+    // status "interrupted" (the Python module's Ctrl-C). Null: every test runs.
+    const std::atomic<bool> *stop = nullptr;
 };
 
 // One row of results.csv / results.json: a test's variables and every figure measured.
@@ -141,6 +145,7 @@ struct ExperimentResult {
     std::vector<ExperimentRow> rows; // one per test run, in order
     int64_t failed = 0;
     double seconds = 0;
+    bool interrupted = false; // ExperimentOptions::stop ended it before its last test
 };
 
 // "K/N" -> (K, N), 1 <= K <= N; throws binocle::Error naming the option and the value.

@@ -294,6 +294,15 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
     const auto start = std::chrono::steady_clock::now();
     for (size_t i = 0; i < selected.size(); ++i) {
+        if (options.stop && options.stop->load()) {
+            // Asked to stop: the tables say "interrupted" and hold the tests done.
+            progress.finish();
+            writeTables(options.out_dir, e, rows, meta);
+            ExperimentResult result = resultOf(rows);
+            result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            result.interrupted = true;
+            return result;
+        }
         const ExperimentTest &t = *selected[i];
         progress.update(static_cast<int64_t>(i), testLabel(t));
         const auto t0 = std::chrono::steady_clock::now();

@@ -26,7 +26,8 @@ struct PluginKind;
 std::map<std::string, std::string> examineInChildren(const std::vector<std::string> &paths, int32_t timeout_ms);
 
 // The helper executable: $BINOCLE_PLUGIN_HELPER, else <prefix>/libexec/binocle/
-// binocle-plugin-helper next to the running executable. Throws Error when absent.
+// binocle-plugin-helper (host/install_prefix.hpp: the prefix a program named, else the
+// running executable's). Throws Error when absent.
 std::string helperExecutable();
 
 // A plugin file's header and settings table, read by a helper process: none of the

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "host/child_process.hpp"
+#include "host/install_prefix.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <algorithm>
@@ -50,10 +51,15 @@ std::string helperExecutable() {
         return env;
     }
     std::error_code ec;
+    const fs::path prefix = installPrefix();
+    const fs::path installed = prefix / "libexec/binocle/binocle-plugin-helper";
+    if (!prefix.empty() && fs::exists(installed, ec)) return installed.lexically_normal().string();
+    if (installPrefixIsSet())
+        throw Error("the plugin helper (binocle-plugin-helper) is not installed under " + prefix.string() +
+                    " (expected " + installed.string() + "); set BINOCLE_PLUGIN_HELPER to its path");
     const fs::path exe = boost::dll::program_location().string();
-    for (const fs::path &candidate : {exe.parent_path().parent_path() / "libexec/binocle/binocle-plugin-helper",
-                                      exe.parent_path() / "binocle-plugin-helper"})
-        if (fs::exists(candidate, ec)) return candidate.lexically_normal().string();
+    const fs::path beside = exe.parent_path() / "binocle-plugin-helper";
+    if (fs::exists(beside, ec)) return beside.lexically_normal().string();
     throw Error("the plugin helper (binocle-plugin-helper) is not installed next to " + exe.string() +
                 " (expected in ../libexec/binocle/); set BINOCLE_PLUGIN_HELPER to its path");
 }

@@ -4,12 +4,12 @@
 #include "host/plugin_host.hpp"
 
 #include "core/log.hpp"
+#include "host/install_prefix.hpp"
 #include "host/isolation.hpp"
 #include "host/plugin_kinds.hpp"
 #include "host/plugin_name.hpp"
 
 #include <algorithm>
-#include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
 #include <cerrno>
 #include <cmath>
@@ -100,14 +100,10 @@ std::vector<std::string> PluginHost::defaultSearchPath() {
         while (std::getline(ss, dir, ':'))
             if (!dir.empty()) path.push_back(dir);
     }
-    try {
-        // The build tree mirrors the install layout (bin/, lib/binocle/plugins/), so this
-        // one entry serves both; nothing about the build tree is compiled in.
-        fs::path exe = boost::dll::program_location().string();
-        path.push_back((exe.parent_path().parent_path() / BINOCLE_PLUGIN_INSTALL_DIR).lexically_normal().string());
-    } catch (...) {
-        // No program location (unusual); the other entries still apply.
-    }
+    // The build tree mirrors the install layout (bin/, lib/binocle/plugins/), so this
+    // one entry serves both; nothing about the build tree is compiled in.
+    if (const std::string prefix = installPrefix(); !prefix.empty())
+        path.push_back((fs::path(prefix) / BINOCLE_PLUGIN_INSTALL_DIR).lexically_normal().string());
     std::vector<std::string> unique;
     for (const auto &d : path) {
         std::error_code ec;

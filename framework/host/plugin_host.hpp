@@ -244,8 +244,9 @@ enum class ScanMode {
 
 class PluginHost {
 public:
-    // $BINOCLE_PLUGIN_PATH (':'-separated), then <prefix>/lib/binocle/plugins next to
-    // the running executable (the build tree mirrors that layout). No path is compiled in.
+    // $BINOCLE_PLUGIN_PATH (':'-separated), then <prefix>/lib/binocle/plugins, the prefix
+    // of host/install_prefix.hpp (the running executable's, or the one a program named,
+    // e.g. the Python module); the build tree mirrors that layout. No path is compiled in.
     static std::vector<std::string> defaultSearchPath();
 
     explicit PluginHost(std::vector<std::string> searchPath = defaultSearchPath());

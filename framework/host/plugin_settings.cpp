@@ -3,10 +3,12 @@
 // settings checker's home in the host.
 #include "host/plugin_host.hpp"
 #include "host/plugin_name.hpp"
+#include "host/setting_json.hpp"
 
 #include <binocle/settings.hpp>
 
 #include <map>
+#include <sstream>
 #include <string>
 
 namespace binocle {
@@ -45,6 +47,44 @@ std::string settingsTableProblem(const binocle_param_desc *params, int32_t count
             return at + ": default '" + d.default_value + "' " + why;
     }
     return "";
+}
+
+// ---- A setting as JSON ------------------------------------------------------------------
+
+const char *settingTypeName(int32_t type) {
+    switch (type) {
+    case BINOCLE_PARAM_BOOL: return "bool";
+    case BINOCLE_PARAM_INT: return "int";
+    case BINOCLE_PARAM_DOUBLE: return "double";
+    case BINOCLE_PARAM_STRING: return "string";
+    case BINOCLE_PARAM_ENUM: return "enum";
+    case BINOCLE_PARAM_PATH: return "path";
+    case BINOCLE_PARAM_YAML: return "yaml";
+    case BINOCLE_PARAM_INT_LIST: return "int_list";
+    case BINOCLE_PARAM_DOUBLE_LIST: return "double_list";
+    default: return "unknown";
+    }
+}
+
+nlohmann::ordered_json settingJson(const binocle_param_desc &d) {
+    using OJson = nlohmann::ordered_json;
+    OJson p = {{"name", d.name}, {"type", settingTypeName(d.type)}};
+    if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) p["min"] = d.min;
+    if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) p["max"] = d.max;
+    if (d.multiple_of > 0) p["multiple_of"] = d.multiple_of;
+    if (d.flags & BINOCLE_PARAM_FLAG_ODD) p["odd"] = true;
+    if (d.flags & BINOCLE_PARAM_FLAG_LIMIT) p["limit"] = true;
+    if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED) p["required"] = true;
+    if (d.choices) {
+        OJson choices = OJson::array();
+        std::stringstream ss(d.choices);
+        for (std::string c; std::getline(ss, c, '|');) choices.push_back(c);
+        p["choices"] = choices;
+    }
+    p["unit"] = d.unit ? d.unit : "";
+    p["help"] = d.help ? d.help : "";
+    p["default"] = d.default_value ? OJson(d.default_value) : OJson(nullptr);
+    return p;
 }
 
 } // namespace binocle

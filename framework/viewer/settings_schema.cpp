@@ -2,6 +2,7 @@
 // Controls from the plugins' settings tables.
 #include "viewer/settings_schema.hpp"
 
+#include "host/setting_json.hpp"
 #include "viewer/page_settings.hpp"
 
 #include <sstream>
@@ -12,41 +13,12 @@ namespace {
 
 using OJson = nlohmann::ordered_json;
 
-const char *typeName(int32_t type) {
-    switch (type) {
-    case BINOCLE_PARAM_BOOL: return "bool";
-    case BINOCLE_PARAM_INT: return "int";
-    case BINOCLE_PARAM_DOUBLE: return "double";
-    case BINOCLE_PARAM_STRING: return "string";
-    case BINOCLE_PARAM_ENUM: return "enum";
-    case BINOCLE_PARAM_PATH: return "path";
-    case BINOCLE_PARAM_YAML: return "yaml";
-    case BINOCLE_PARAM_INT_LIST: return "int_list";
-    case BINOCLE_PARAM_DOUBLE_LIST: return "double_list";
-    default: return "unknown";
-    }
-}
-
 OJson block(const PluginBlock &b, const std::string &key) {
     OJson out = {{"key", key}, {"where", b.where}, {"plugin", b.plugin}, {"kind", b.record ? kindName(b.record->kind) : ""}};
     OJson params = OJson::array();
     if (b.record) {
         for (const binocle_param_desc &d : b.record->params()) {
-            OJson p = {{"name", d.name}, {"type", typeName(d.type)}};
-            if (d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) p["min"] = d.min;
-            if (d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) p["max"] = d.max;
-            if (d.multiple_of > 0) p["multiple_of"] = d.multiple_of;
-            if (d.flags & BINOCLE_PARAM_FLAG_ODD) p["odd"] = true;
-            if (d.flags & BINOCLE_PARAM_FLAG_LIMIT) p["limit"] = true; // shown, not a control
-            if (d.choices) {
-                OJson choices = OJson::array();
-                std::stringstream ss(d.choices);
-                for (std::string c; std::getline(ss, c, '|');) choices.push_back(c);
-                p["choices"] = choices;
-            }
-            p["unit"] = d.unit ? d.unit : "";
-            p["help"] = d.help ? d.help : "";
-            p["default"] = d.default_value ? OJson(d.default_value) : OJson(nullptr);
+            OJson p = settingJson(d);
             if (const binocle_param *v = b.params.find(d.name)) {
                 p["value"] = paramText(*v);
                 p["explicit"] = v->explicit_ != 0;

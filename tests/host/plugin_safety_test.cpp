@@ -5,8 +5,11 @@
 // the search path are refused with the reason; matcher values and failed releases are
 // checked at run.
 #include "fixture_host.hpp"
+#include "host/install_prefix.hpp"
+#include "host/isolation.hpp"
 
 #include <chrono>
+#include <fstream>
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
@@ -139,6 +142,37 @@ TEST(PluginSafety, NoBuildTreePathIsCompiledIn) {
     // The second entry is derived from this executable's location, not from the build.
     EXPECT_EQ(std::filesystem::path(path[1]).filename(), "plugins");
     EXPECT_NE(path[1], BINOCLE_BUILD_PLUGIN_DIR); // tests do not live in bin/
+}
+
+// A program that carries the framework but is not bin/binocle (the Python module inside
+// python3) names its prefix: the plugins and the helper are looked for there, and only there.
+TEST(PluginSafety, ANamedInstallPrefixLeadsToItsPluginsAndHelper) {
+    namespace fs = std::filesystem;
+    const fs::path prefix = fs::temp_directory_path() / ("binocle-prefix-" + std::to_string(::getpid()));
+    fs::create_directories(prefix / "libexec/binocle");
+    EXPECT_THROW(setInstallPrefix("relative/prefix"), Error);
+    setInstallPrefix(prefix.string());
+    ::setenv("BINOCLE_PLUGIN_PATH", "/opt/example/plugins", 1);
+    const auto path = PluginHost::defaultSearchPath();
+    ::setenv("BINOCLE_PLUGIN_PATH", BINOCLE_BUILD_PLUGIN_DIR, 1);
+    EXPECT_EQ(path, (std::vector<std::string>{"/opt/example/plugins", (prefix / "lib/binocle/plugins").string()}));
+    const char *helperEnv = std::getenv("BINOCLE_PLUGIN_HELPER");
+    const std::string savedHelper = helperEnv ? helperEnv : "";
+    ::unsetenv("BINOCLE_PLUGIN_HELPER");
+    try {
+        helperExecutable();
+        ADD_FAILURE() << "a helper was found under a prefix that has none";
+    } catch (const Error &e) {
+        EXPECT_THAT(e.what(), HasSubstr("not installed under " + prefix.string()));
+    }
+    const fs::path helper = prefix / "libexec/binocle/binocle-plugin-helper";
+    std::ofstream(helper.string()) << "#!/bin/sh\n";
+    EXPECT_EQ(helperExecutable(), helper.string());
+    if (!savedHelper.empty()) ::setenv("BINOCLE_PLUGIN_HELPER", savedHelper.c_str(), 1);
+    setInstallPrefix("");
+    EXPECT_FALSE(installPrefixIsSet());
+    EXPECT_NE(installPrefix(), prefix.string());
+    fs::remove_all(prefix);
 }
 
 // Captures what the host logs through spdlog's default logger while alive.

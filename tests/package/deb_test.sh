@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Builds the binocle and binocle-dev packages (cpack -G DEB) from the build tree given as
-# $1, extracts them with dpkg -x into a temporary prefix and runs `binocle plugins` and
-# a rig from there, with BINOCLE_PLUGIN_PATH unset: the extracted tree must find its own
-# plugins and configs.
+# Builds the binocle and binocle-dev packages, and python3-binocle when the module is
+# built (cpack -G DEB), from the build tree given as $1, extracts them with dpkg -x into a
+# temporary prefix and runs `binocle plugins` and a rig from there (and from Python),
+# with BINOCLE_PLUGIN_PATH unset: the extracted tree must find its own plugins and configs.
 set -euo pipefail
 build_dir=$(cd "$1" && pwd)
 work=$(mktemp -d)
@@ -36,4 +36,28 @@ grep -q '"status": "ok"' "$work/out/summary.json" || fail "the rig did not run f
 grep -q "complete .*binocle" root/usr/share/bash-completion/completions/binocle || fail "empty bash completion"
 [ -f root/usr/include/binocle/plugin.hpp ] || fail "binocle-dev lacks the SDK headers"
 [ -f root/usr/lib/cmake/Binocle/BinocleConfig.cmake ] || fail "binocle-dev lacks the CMake package"
+# python3-binocle, when the module was built: imported from the unpacked tree, it finds
+# the plugins and the helper of the unpacked binocle package from its own folder.
+if ls pkg/python3-binocle_*.deb >/dev/null 2>&1; then
+  pydeb=$(ls pkg/python3-binocle_*.deb)
+  dpkg-deb --field "$pydeb" Package | grep -qx python3-binocle
+  dpkg -x "$pydeb" root
+  [ -f root/usr/lib/python3/dist-packages/binocle/__init__.pyi ] || fail "python3-binocle lacks its type stubs"
+  PYTHONPATH="$work/root/usr/lib/python3/dist-packages" /usr/bin/python3 - "$work/root/usr" <<'PY' || fail "the python3-binocle package does not run from the package"
+import sys
+import binocle
+prefix = sys.argv[1]
+assert binocle.install_prefix() == prefix, binocle.install_prefix()
+plugins = {p["name"]: p["path"] for p in binocle.plugins()}
+for name in ("replay", "bm", "ground"):
+    assert plugins[name] == f"{prefix}/lib/binocle/plugins/binocle_{name}.so", plugins
+rig = binocle.Rig(f"{prefix}/share/binocle/configs/rigs/opencv-aloe.yaml",
+                  set={"matcher.plugin": "bm", "matcher.num_disparities": 128, "matcher.block_size": 15,
+                       "matcher.isolation": "process"})
+run = rig.run(frames=1)
+frames = list(run)
+assert frames[0].disparity.shape == (1110, 1282) and run.summary["status"] == "ok", run.summary
+print("python3-binocle OK")
+PY
+fi
 echo "packages OK"

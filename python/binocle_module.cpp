@@ -1,0 +1,351 @@
+// SPDX-License-Identifier: MIT
+// The `binocle` Python module (_binocle; binocle/__init__.py re-exports it): Rig and its
+// runs, experiment(), plugins(), the exceptions. The same framework code as the CLI.
+#include "python/convert.hpp"
+#include "python/run_stream.hpp"
+
+#include "config/rig_config.hpp"
+#include "core/atomic_file.hpp"
+#include "core/log.hpp"
+#include "core/output_folder.hpp"
+#include "experiment/experiment.hpp"
+#include "host/install_prefix.hpp"
+#include "host/setting_json.hpp"
+#include "input/image_file.hpp"
+
+#include <pybind11/stl.h>
+
+#include <condition_variable>
+#include <cstdlib>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <filesystem>
+
+namespace py = pybind11;
+using namespace binocle;
+using namespace binocle::python;
+namespace fs = std::filesystem;
+
+namespace {
+
+// How often a waiting iterator looks for Ctrl-C (PyErr_CheckSignals).
+constexpr std::chrono::milliseconds kSignalPoll{50};
+
+PyObject *g_error = nullptr, *g_usageError = nullptr, *g_pluginError = nullptr;
+
+// A mistake in the call's arguments: raised as binocle.UsageError (a ValueError).
+struct ArgumentError : Error {
+    using Error::Error;
+};
+
+std::shared_ptr<const LoadedRig> loadRigFile(const std::string &file, const py::object &set) {
+    auto loaded = std::make_shared<LoadedRig>();
+    loaded->host = std::make_unique<PluginHost>();
+    std::vector<Override> overrides;
+    for (const std::string &text : setTexts(set)) overrides.push_back(Override::parse(text));
+    py::gil_scoped_release release;
+    // No scan: the rig opens only the plugins it names (as `binocle run`).
+    loaded->rig = loadRig(file, overrides, *loaded->host);
+    return loaded;
+}
+
+// The iterator of Rig.run(): frames as they finish; the run on its own thread.
+class Run {
+public:
+    Run(std::shared_ptr<const LoadedRig> rig, const StreamOptions &options) {
+        py::gil_scoped_release release;
+        stream_ = std::make_unique<RunStream>(std::move(rig), options);
+    }
+    ~Run() { close(false); }
+
+    Frame next() {
+        if (!stream_) throw py::stop_iteration();
+        for (;;) {
+            std::shared_ptr<OwnedFrame> frame;
+            RunStream::Next n;
+            {
+                py::gil_scoped_release release;
+                n = stream_->next(frame, kSignalPoll);
+            }
+            if (n == RunStream::Next::Frame) return toFrame(std::move(frame));
+            if (n == RunStream::Next::End) {
+                close(true);
+                throw py::stop_iteration();
+            }
+            if (PyErr_CheckSignals() != 0) {
+                // Ctrl-C: the run stops as `binocle run` does on SIGINT (frames in flight
+                // finished, summary written, status interrupted), then the
+                // KeyboardInterrupt goes on.
+                py::error_already_set pending;
+                close(false);
+                throw pending;
+            }
+        }
+    }
+
+    // Stops the run (if still going) and waits for it; its error is raised when `raise`.
+    void close(bool raise) {
+        if (!stream_) return;
+        {
+            py::gil_scoped_release release;
+            if (!raise) stream_->stop();
+            try {
+                stream_->finish();
+            } catch (...) {
+                summary_ = stream_->summary();
+                stream_.reset();
+                if (raise) throw;
+                return;
+            }
+            summary_ = stream_->summary();
+            stream_.reset();
+        }
+    }
+
+    py::object summary() const { return summary_.is_null() ? py::none() : toPython(summary_); }
+
+private:
+    std::unique_ptr<RunStream> stream_;
+    nlohmann::ordered_json summary_;
+};
+
+class Rig {
+public:
+    Rig(const std::string &file, const py::object &set) : rig_(loadRigFile(file, set)) {}
+
+    std::unique_ptr<Run> run(const py::object &frames, const py::object &out, bool force, bool progress, int64_t queue_depth) {
+        StreamOptions options;
+        if (!frames.is_none()) {
+            options.max_frames = frames.cast<int64_t>();
+            if (options.max_frames < 1) throw ArgumentError("frames=" + std::to_string(options.max_frames) + ": expected a whole number >= 1 (or None: until the source ends)");
+        }
+        if (!out.is_none()) options.out_dir = py::str(out).cast<std::string>();
+        if (queue_depth < 1) throw ArgumentError("queue_depth=" + std::to_string(queue_depth) + ": expected a whole number >= 1");
+        options.depth = static_cast<size_t>(queue_depth);
+        options.force = force;
+        options.progress = progress;
+        return std::make_unique<Run>(rig_, options);
+    }
+
+    const RigConfig &config() const { return rig_->rig; }
+
+private:
+    std::shared_ptr<const LoadedRig> rig_;
+};
+
+py::dict pluginDict(const PluginRecord &p) {
+    py::dict d;
+    d["name"] = p.name;
+    d["kind"] = kindName(p.kind);
+    d["version"] = p.version;
+    d["abi_version"] = p.abi_version;
+    d["api_version"] = p.api_version;
+    d["description"] = p.description;
+    d["path"] = p.path;
+    py::list settings;
+    for (const binocle_param_desc &s : p.params()) settings.append(toPython(settingJson(s)));
+    d["settings"] = settings;
+    return d;
+}
+
+// What `binocle plugins` finds: the same search path and the same isolated scan.
+std::unique_ptr<PluginHost> scannedHost(const std::vector<std::string> &load, int64_t timeout_ms) {
+    if (timeout_ms < 100) throw ArgumentError("timeout_ms=" + std::to_string(timeout_ms) + ": expected a whole number >= 100");
+    auto host = std::make_unique<PluginHost>();
+    py::gil_scoped_release release;
+    for (const auto &p : load) host->load(p);
+    host->scan(ScanMode::Isolated, static_cast<int32_t>(timeout_ms));
+    return host;
+}
+
+py::dict experiment(const std::string &file, const py::object &set, const py::object &out, const std::vector<std::string> &tests,
+                    bool force, bool progress) {
+    const std::vector<std::string> overrides = setTexts(set);
+    const std::string outText = out.is_none() ? "" : py::str(out).cast<std::string>();
+    ExperimentResult result;
+    ExperimentOptions options;
+    {
+        py::gil_scoped_release release;
+        PluginHost host;
+        // Everything is checked before the first test runs (as `binocle experiment`).
+        const Experiment e = loadExperiment(file, host, overrides);
+        options.out_dir = outText.empty() ? "out/" + e.name : outText;
+        options.progress = progress;
+        options.replace = force;
+        options.only = tests;
+        const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, force, "binocle.experiment"});
+        // The tests run on a thread of their own, so that this one sees Ctrl-C: no further
+        // test starts, the tables say "interrupted", then the KeyboardInterrupt goes on.
+        std::atomic<bool> stop{false};
+        options.stop = &stop;
+        std::exception_ptr error;
+        std::mutex mutex;
+        std::condition_variable ended;
+        bool done = false;
+        std::thread worker([&] {
+            try {
+                result = runExperiment(e, host, options);
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(mutex);
+            done = true;
+            ended.notify_all();
+        });
+        std::optional<py::error_already_set> interrupt;
+        for (std::unique_lock<std::mutex> lock(mutex); !ended.wait_for(lock, kSignalPoll, [&] { return done; });) {
+            if (interrupt || stop) continue;
+            lock.unlock();
+            py::gil_scoped_acquire acquire;
+            if (PyErr_CheckSignals() != 0) {
+                interrupt.emplace();
+                stop = true;
+            }
+            lock.lock();
+        }
+        worker.join();
+        if (interrupt) {
+            py::gil_scoped_acquire acquire;
+            throw *interrupt;
+        }
+        if (error) std::rethrow_exception(error);
+    }
+    // What the command wrote, as data: results.json (rows under "tests", with their
+    // per-repeat details), plus where it lies and the run's own counts.
+    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(readTextFile((fs::path(options.out_dir) / "results.json").string()));
+    doc["out"] = options.out_dir;
+    doc["failed"] = result.failed;
+    doc["seconds"] = result.seconds;
+    return toPython(doc).cast<py::dict>();
+}
+
+void translate(std::exception_ptr p) {
+    try {
+        if (p) std::rethrow_exception(p);
+    } catch (const OverrideError &e) {
+        PyErr_SetString(g_usageError, e.what());
+    } catch (const ArgumentError &e) {
+        PyErr_SetString(g_usageError, e.what());
+    } catch (const PluginError &e) {
+        PyErr_SetString(g_pluginError, e.what());
+    } catch (const Error &e) {
+        PyErr_SetString(g_error, e.what());
+    }
+}
+
+PyObject *newException(py::module_ &m, const char *name, const char *doc, py::tuple bases) {
+    const std::string qualified = std::string("binocle.") + name;
+    PyObject *type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases.ptr(), nullptr);
+    if (!type) throw py::error_already_set();
+    m.add_object(name, py::handle(type));
+    return type;
+}
+
+} // namespace
+
+PYBIND11_MODULE(_binocle, m) {
+    m.doc() = "Binocle from Python: rigs run through the framework's stage pipeline, experiments and the plugin list.";
+    // The CLI's limit for the image formats whose header input/image_file.cpp does not read.
+    ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(input::kMaxImagePixels).c_str(), 0);
+    // Warnings and errors as the CLI words them ("binocle: warn: ..."), on stderr.
+    LogOptions log;
+    log.program = "binocle";
+    setupLogging(log);
+
+    g_error = newException(m, "Error", "An error of Binocle: a file, key, value, plugin or device, named with what was expected "
+                                       "(the message of the `binocle` command for the same mistake).",
+                           py::make_tuple(py::handle(PyExc_RuntimeError)));
+    g_usageError = newException(m, "UsageError", "A mistake in the call: a `set` key or value, an argument (exit status 2 of the CLI).",
+                                py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError)));
+    g_pluginError = newException(m, "PluginError", "A plugin refused a call or misbehaved; the message names it.",
+                                 py::make_tuple(py::handle(g_error)));
+    py::register_exception_translator(&translate);
+
+    m.def("_set_install_prefix", &setInstallPrefix, py::arg("prefix"),
+          "Where the plugins (lib/binocle/plugins) and the plugin helper (libexec/binocle) lie; set by binocle/__init__.py.");
+    m.def("install_prefix", &installPrefix, "The prefix the plugins and the plugin helper are found under.");
+    m.attr("__version__") = BINOCLE_VERSION;
+    m.attr("ABI_VERSION") = BINOCLE_ABI_VERSION;
+    m.attr("API_VERSION") = BINOCLE_API_VERSION;
+
+    py::class_<Frame>(m, "Frame", "One finished frame of a run; the arrays are owned by the frame (valid as long as they are used).")
+        .def_readonly("index", &Frame::index, "0, 1, 2 ... frames finished in this run")
+        .def_readonly("sequence", &Frame::sequence, "the source's sequence number")
+        .def_readonly("left", &Frame::left, "rectified left image: H x W uint8, or H x W x 3 (BGR)")
+        .def_readonly("right", &Frame::right, "rectified right image, as left")
+        .def_readonly("disparity", &Frame::disparity, "H x W float32 disparity in pixels; invalid pixels <= 0")
+        .def_readonly("cloud", &Frame::cloud, "N x 3 float32 points in mm, in `cloud_frame` (ground after a ground transform)")
+        .def_readonly("colors", &Frame::colors, "N x 3 uint8 (R, G, B) per point, or 0 x 3 without colours")
+        .def_readonly("cloud_frame", &Frame::cloud_frame, "'ground' or 'camera'")
+        .def_readonly("figures", &Frame::figures, "every evaluator figure of the frame: {'evaluator.metric': value}")
+        .def_readonly("metrics", &Frame::metrics, "the same, nested: {evaluator: {metric: value}}")
+        .def_readonly("valid_pixel_ratio", &Frame::valid_pixel_ratio, "share of pixels with a disparity")
+        .def_readonly("seconds", &Frame::seconds, "processing time of the frame, all stages added")
+        .def_readonly("latency_s", &Frame::latency_s, "from the grab to the writer stage")
+        .def("__repr__", [](const Frame &f) {
+            return "<binocle.Frame " + std::to_string(f.index) + ": " + std::to_string(f.cloud.shape(0)) + " points, valid " +
+                   std::to_string(f.valid_pixel_ratio) + ">";
+        });
+
+    py::class_<Run>(m, "Run",
+                    "The frames of a run, in order, as they finish; the pipeline works on its own threads meanwhile.\n"
+                    "Leaving the loop early (break, an exception, Ctrl-C) or close() stops the run as SIGINT does for\n"
+                    "`binocle run`: the frames in flight are finished, the summary (summary.json with out=) says\n"
+                    "'interrupted'.")
+        .def("__iter__", [](py::object self) { return self; })
+        .def("__next__", &Run::next)
+        .def("close", [](Run &r) { r.close(false); }, "Stops the run, if still going, and waits for its end.")
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](Run &r, const py::object &, const py::object &, const py::object &) { r.close(false); })
+        .def_property_readonly("summary", &Run::summary,
+                               "The run's summary (as summary.json: status, frame_count, metrics ...) once it ended; None before.");
+
+    py::class_<Rig>(m, "Rig",
+                    "A rig file, loaded and checked as `binocle run RIG --set KEY=VALUE` does.\n\n"
+                    "set: {'matcher.num_disparities': 128} or ['matcher.num_disparities=128']; values other than\n"
+                    "strings are written as YAML (True -> true). A bad key or value raises binocle.UsageError with the\n"
+                    "CLI's message (file:line:col, 'did you mean').")
+        .def(py::init<const std::string &, const py::object &>(), py::arg("file"), py::arg("set") = py::none())
+        .def("run", &Rig::run, py::arg("frames") = py::none(), py::arg("out") = py::none(), py::arg("force") = false,
+             py::arg("progress") = false, py::arg("queue_depth") = 4,
+             "Runs the rig's stage pipeline (that of `binocle run`) and returns the iterator of its frames.\n"
+             "frames: stop after N frames (None: until the source ends); out: also write the outputs of\n"
+             "`binocle run --out DIR` there; force: as --force; queue_depth: finished frames that may wait for\n"
+             "the loop (the pipeline waits beyond).")
+        .def_property_readonly("name", [](const Rig &r) { return r.config().name; })
+        .def_property_readonly("file", [](const Rig &r) { return r.config().file; }, "absolute path of the rig file")
+        .def_property_readonly("yaml", [](const Rig &r) { return r.config().resolved_yaml; }, "the rig after the set overrides")
+        .def_property_readonly("source", [](const Rig &r) { return r.config().source.plugin; }, "the source plugin's name")
+        .def_property_readonly("matcher", [](const Rig &r) { return r.config().matcher.plugin; }, "the matcher plugin's name")
+        .def("__repr__", [](const Rig &r) { return "<binocle.Rig '" + r.config().name + "' " + r.config().file + ">"; });
+
+    m.def("experiment", &experiment, py::arg("file"), py::arg("set") = py::none(), py::arg("out") = py::none(),
+          py::arg("tests") = std::vector<std::string>{}, py::arg("force") = false, py::arg("progress") = false,
+          "Runs an experiment file as `binocle experiment FILE --set KEY=VALUE --out DIR --tests ...` does and\n"
+          "returns what it wrote into DIR (default out/<name>) as results.json, a dict with the rows under 'tests'\n"
+          "([{'test': id, 'status': ..., column: value ...}]), plus 'out' (DIR), 'failed' and 'seconds'.");
+    m.def(
+        "plugins",
+        [](const std::vector<std::string> &load, int64_t timeout_ms) {
+            const auto host = scannedHost(load, timeout_ms);
+            py::list out;
+            for (const auto &p : host->plugins()) out.append(pluginDict(p));
+            return out;
+        },
+        py::arg("load") = std::vector<std::string>{}, py::arg("timeout_ms") = 5000,
+        "The plugins `binocle plugins` lists: [{'name', 'kind', 'version', 'abi_version', 'api_version',\n"
+        "'description', 'path', 'settings': [{'name', 'type', 'default', 'unit', 'help', 'min', 'max', ...}]}].");
+    m.def(
+        "refused_plugins",
+        [](const std::vector<std::string> &load, int64_t timeout_ms) {
+            const auto host = scannedHost(load, timeout_ms);
+            py::list out;
+            for (const auto &r : host->refused()) out.append(py::dict(py::arg("path") = r.path, py::arg("reason") = r.reason));
+            return out;
+        },
+        py::arg("load") = std::vector<std::string>{}, py::arg("timeout_ms") = 5000,
+        "The files `binocle plugins` lists as refused: [{'path', 'reason'}].");
+    m.def("plugin_search_path", &PluginHost::defaultSearchPath,
+          "The folders searched for plugins: $BINOCLE_PLUGIN_PATH, then <prefix>/lib/binocle/plugins.");
+}
