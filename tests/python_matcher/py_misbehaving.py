@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: MIT
+# py_misbehaving: a test fixture, a Python matcher that goes wrong in the way its
+# `behaviour` setting names (tests/python_matcher, bench/bench_python.cpp). Its default,
+# zeros, is a well-behaved matcher that finds nothing (the benchmark's "no work").
+import os
+import time
+
+import numpy as np
+
+
+class Misbehaving:
+    name = "py_misbehaving"
+    kind = "matcher"
+    version = "0.1.0"
+    description = "test fixture: a Python matcher that fails as its behaviour setting says"
+    settings = [
+        {"name": "behaviour", "type": "enum", "default": "zeros",
+         "choices": ["zeros", "fixed_point", "raise", "wrong_shape", "wrong_dtype", "not_an_array", "nan", "hang",
+                     "crash", "raise_in_init"],
+         "help": "what compute does: zeros (all invalid), fixed_point (int16 x 16: disparity 5), raise, "
+                 "wrong_shape, wrong_dtype, not_an_array, nan, hang (never returns), crash (abort), raise_in_init"},
+        {"name": "num_disparities", "type": "int", "default": 16, "min": 1, "multiple_of": 16, "unit": "px",
+         "help": "what disparity_range answers"},
+    ]
+
+    def __init__(self, settings):
+        self.behaviour = settings["behaviour"]
+        if self.behaviour == "raise_in_init":
+            raise RuntimeError("fixture: refusing to be made")
+        self.num_disparities = settings["num_disparities"]
+
+    def disparity_range(self):
+        return (0, self.num_disparities)
+
+    def compute(self, left, right):
+        height, width = left.shape[:2]
+        b = self.behaviour
+        if b == "fixed_point":
+            return np.full((height, width), 5 * 16, np.int16)
+        if b == "raise":
+            raise ValueError("fixture: this pair is not to my taste")
+        if b == "wrong_shape":
+            return np.zeros((height, width + 1), np.float32)
+        if b == "wrong_dtype":
+            return np.zeros((height, width), np.float64)
+        if b == "not_an_array":
+            return None
+        if b == "nan":
+            d = np.ones((height, width), np.float32)
+            d[: height // 2] = np.nan
+            return d
+        if b == "hang":
+            while True:
+                time.sleep(1)
+        if b == "crash":
+            os.abort()
+        return np.zeros((height, width), np.float32)
+
+
+binocle_plugin = Misbehaving

@@ -1,0 +1,105 @@
+# SPDX-License-Identifier: MIT
+# Python matchers that go wrong (the py_misbehaving fixture): every failure is a clear
+# error naming the plugin, its file and what went wrong, and the run ends with its
+# summary; a crash or a hang is contained by `isolation: process`.
+import re
+import time
+
+import pytest
+
+from common import SIM_RIG, binocle, misbehaving, summary
+
+FIXTURE = "binocle_py_misbehaving.py"
+
+
+def failed_run(tmp_path, behaviour, isolated=False, extra=""):
+    out = str(tmp_path / "out")
+    started = time.monotonic()
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", out, "--set", misbehaving(behaviour, isolated, extra))
+    seconds = time.monotonic() - started
+    assert r.returncode == 1, r.stdout + r.stderr
+    s = summary(out)
+    assert s["status"] == "failed", s
+    return r.stderr, s["error"], seconds
+
+
+@pytest.mark.parametrize("isolated", [False, True])
+def test_exception_names_type_message_and_line(tmp_path, isolated):
+    stderr, error, _ = failed_run(tmp_path, "raise", isolated)
+    for text in (stderr, error):
+        assert "py_misbehaving" in text
+        assert "compute raised ValueError: fixture: this pair is not to my taste" in text
+        assert re.search(FIXTURE + r":\d+ in compute\)", text), text
+
+
+def test_exception_in_init_refuses_the_run(tmp_path):
+    # create fails before the run starts: refused like any plugin's create, nothing written.
+    out = tmp_path / "out"
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", str(out), "--set", misbehaving("raise_in_init"))
+    assert r.returncode == 1, r.stderr
+    assert "create failed" in r.stderr
+    assert "__init__ raised RuntimeError: fixture: refusing to be made" in r.stderr
+    assert re.search(FIXTURE + r":\d+ in __init__\)", r.stderr), r.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("behaviour, said", [
+    ("wrong_shape", "compute returned a numpy array of dtype float32, shape (240, 321); expected a numpy array of "
+                    "shape (240, 320)"),
+    ("wrong_dtype", "compute returned a numpy array of dtype float64, shape (240, 320); expected"),
+    ("not_an_array", "compute returned a NoneType; expected a numpy array"),
+    ("nan", "compute returned 38400 of 76800 disparities not finite (NaN or infinite)"),
+])
+def test_wrong_results_are_refused(tmp_path, behaviour, said):
+    stderr, error, _ = failed_run(tmp_path, behaviour)
+    assert said in error
+    assert "py_misbehaving" in error and FIXTURE in error
+    assert said in stderr
+
+
+def test_hang_is_killed_at_the_call_timeout(tmp_path):
+    stderr, error, seconds = failed_run(tmp_path, "hang", True, "call_timeout_ms: 3000")
+    assert "compute did not return within 3000 ms (call_timeout_ms)" in error, error
+    assert seconds < 60
+
+
+def test_crash_is_contained(tmp_path):
+    stderr, error, _ = failed_run(tmp_path, "crash", True)
+    assert "compute crashed in its helper process" in error and "SIGABRT" in error, error
+
+
+def test_crash_restarts_as_configured(tmp_path):
+    # restart: true: a new helper, the frame that crashed has no disparity, the run goes on.
+    out = str(tmp_path / "out")
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", out, "--set",
+                misbehaving("crash", True, "restart: true, max_restarts: 1"))
+    assert r.returncode == 0, r.stderr
+    assert "compute crashed in its helper process (killed by signal 6 (SIGABRT)); restarting its helper (1 of 1)" in r.stderr
+    s = summary(out)
+    assert s["status"] == "ok" and s["isolation"]["matcher"] == {"plugin": "py_misbehaving", "restarts": 1,
+                                                                 "lost_calls": 1}, s
+
+
+def test_settings_are_checked_before_it_runs(tmp_path):
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", str(tmp_path / "out"),
+                "--set", misbehaving("explode"))
+    assert r.returncode == 2, r.stderr
+    assert "matcher.behaviour: value 'explode' is not valid: expected one of zeros, fixed_point" in r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_fixed_point_result_is_read_as_pixels_times_16(tmp_path):
+    out = str(tmp_path / "out")
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", out, "--set", misbehaving("fixed_point"))
+    assert r.returncode == 0, r.stderr
+    s = summary(out)
+    assert s["status"] != "failed", s
+
+
+def test_plugins_refuses_broken_python_plugins():
+    r = binocle("plugins")
+    assert r.returncode == 0, r.stderr
+    listing = r.stdout + r.stderr
+    assert re.search(r"py_bad_table.*window_px.*default '4' is not odd", listing), listing
+    assert "binocle_py_import_error.so" in listing
+    assert "ImportError: fixture: a module this plugin needs is missing" in r.stderr, r.stderr
