@@ -197,12 +197,16 @@ Module &module() {
     return m;
 }
 
-// Bytes Python owns, copied from a host image: GRAY8 as is, BGR8 swapped to RGB.
-Ref pixels(const binocle_image &im) {
+// Fills bytes Python owns from a host image: GRAY8 as is, BGR8 swapped to RGB. The
+// last call's bytes are reused when nothing in Python refers to them any more (no page
+// faults on fresh memory each frame); a matcher that kept its input gets new ones.
+void fill(Ref &bytes, const binocle_image &im) {
     const int channels = im.format == BINOCLE_PIXEL_GRAY8 ? 1 : 3;
     const size_t row = static_cast<size_t>(im.width) * channels;
-    Ref bytes(PyByteArray_FromStringAndSize(nullptr, static_cast<Py_ssize_t>(row * im.height)));
-    if (!bytes) return bytes;
+    const auto size = static_cast<Py_ssize_t>(row * im.height);
+    if (!bytes || Py_REFCNT(bytes.get()) != 1 || PyByteArray_Size(bytes.get()) != size)
+        bytes = Ref(PyByteArray_FromStringAndSize(nullptr, size));
+    if (!bytes) return;
     auto *out = reinterpret_cast<uint8_t *>(PyByteArray_AsString(bytes.get()));
     for (int y = 0; y < im.height; ++y) {
         const auto *in = static_cast<const uint8_t *>(im.data) + static_cast<size_t>(y) * im.stride_bytes;
@@ -217,7 +221,18 @@ Ref pixels(const binocle_image &im) {
             std::memcpy(o, in, row);
         }
     }
-    return bytes;
+}
+
+// Disparities that are NaN or infinite in a row (exponent bits all set), in a loop the
+// compiler vectorises.
+size_t nonFiniteIn(const float *row, int n) {
+    size_t count = 0;
+    for (int x = 0; x < n; ++x) {
+        uint32_t bits;
+        std::memcpy(&bits, row + x, sizeof bits);
+        count += (bits & 0x7f800000u) == 0x7f800000u;
+    }
+    return count;
 }
 
 class PyMatcher : public binocle::sdk::Matcher {
@@ -247,16 +262,19 @@ public:
     ~PyMatcher() override {
         Gil gil;
         instance_ = Ref();
+        leftBytes_ = Ref();
+        rightBytes_ = Ref();
     }
 
     void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) override {
         checkInputs(left, right, disparity);
         Gil gil;
         const int channels = left.format == BINOCLE_PIXEL_GRAY8 ? 1 : 3;
-        Ref lb = pixels(left), rb = pixels(right);
-        if (!lb || !rb) fail("compute", BINOCLE_ERR_INTERNAL);
-        Ref l(PyObject_CallMethod(m_.shim, "image", "Oiii", lb.get(), left.height, left.width, channels));
-        Ref r(l ? PyObject_CallMethod(m_.shim, "image", "Oiii", rb.get(), left.height, left.width, channels) : nullptr);
+        fill(leftBytes_, left);
+        fill(rightBytes_, right);
+        if (!leftBytes_ || !rightBytes_) fail("compute", BINOCLE_ERR_INTERNAL);
+        Ref l(PyObject_CallMethod(m_.shim, "image", "Oiii", leftBytes_.get(), left.height, left.width, channels));
+        Ref r(l ? PyObject_CallMethod(m_.shim, "image", "Oiii", rightBytes_.get(), left.height, left.width, channels) : nullptr);
         if (!r) fail("compute", BINOCLE_ERR_INTERNAL);
         Ref result(PyObject_CallMethod(instance_.get(), "compute", "OO", l.get(), r.get()));
         if (!result) fail("compute", BINOCLE_ERR_INTERNAL);
@@ -321,7 +339,14 @@ private:
         for (int y = 0; y < d.height; ++y) {
             const char *in = static_cast<const char *>(view.buf) + y * view.strides[0];
             float *out = reinterpret_cast<float *>(static_cast<char *>(d.data) + static_cast<size_t>(y) * d.stride_bytes);
-            if (isFloat) {
+            if (isFloat && view.strides[1] == 4) {
+                std::memcpy(out, in, static_cast<size_t>(d.width) * 4);
+                if (size_t bad = nonFiniteIn(out, d.width)) {
+                    nonFinite += bad;
+                    for (int x = 0; x < d.width; ++x)
+                        if (!std::isfinite(out[x])) out[x] = BINOCLE_INVALID_DISPARITY;
+                }
+            } else if (isFloat) {
                 for (int x = 0; x < d.width; ++x) {
                     float v;
                     std::memcpy(&v, in + x * view.strides[1], sizeof v);
@@ -344,7 +369,7 @@ private:
     }
 
     Module &m_;
-    Ref instance_;
+    Ref instance_, leftBytes_, rightBytes_;
 };
 
 } // namespace

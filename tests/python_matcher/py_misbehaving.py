@@ -17,7 +17,7 @@ class Misbehaving:
         {"name": "behaviour", "type": "enum", "default": "zeros",
          "choices": ["zeros", "fixed_point", "raise", "wrong_shape", "wrong_dtype", "not_an_array", "nan", "hang",
                      "crash", "raise_in_init"],
-         "help": "what compute does: zeros (all invalid), fixed_point (int16 x 16: disparity 5), raise, "
+         "help": "what compute does: zeros (all invalid, one array reused), fixed_point (int16 x 16: disparity 5), raise, "
                  "wrong_shape, wrong_dtype, not_an_array, nan, hang (never returns), crash (abort), raise_in_init"},
         {"name": "num_disparities", "type": "int", "default": 16, "min": 1, "multiple_of": 16, "unit": "px",
          "help": "what disparity_range answers"},
@@ -54,7 +54,10 @@ class Misbehaving:
                 time.sleep(1)
         if b == "crash":
             os.abort()
-        return np.zeros((height, width), np.float32)
+        # zeros: made once per size, as a matcher that reuses its buffers would.
+        if getattr(self, "zeros", None) is None or self.zeros.shape != (height, width):
+            self.zeros = np.zeros((height, width), np.float32)
+        return self.zeros
 
 
 binocle_plugin = Misbehaving
