@@ -197,12 +197,15 @@ Module &module() {
     return m;
 }
 
-// Fills bytes Python owns from a host image: GRAY8 as is, BGR8 swapped to RGB. The
-// last call's bytes are reused when nothing in Python refers to them any more (no page
-// faults on fresh memory each frame); a matcher that kept its input gets new ones.
+int channelsOf(const binocle_image &im) {
+    return im.format == BINOCLE_PIXEL_BGR8 || im.format == BINOCLE_PIXEL_RGB8 ? 3 : 1;
+}
+
+// Fills bytes Python owns from a host image: BGR8 swapped to RGB, others as they are.
+// The last call's bytes are reused when nothing in Python refers to them any more (no
+// page faults on fresh memory each frame); a matcher that kept its input gets new ones.
 void fill(Ref &bytes, const binocle_image &im) {
-    const int channels = im.format == BINOCLE_PIXEL_GRAY8 ? 1 : 3;
-    const size_t row = static_cast<size_t>(im.width) * channels;
+    const size_t row = static_cast<size_t>(im.width) * binocle::sdk::bytesPerPixel(im.format);
     const auto size = static_cast<Py_ssize_t>(row * im.height);
     if (!bytes || Py_REFCNT(bytes.get()) != 1 || PyByteArray_Size(bytes.get()) != size)
         bytes = Ref(PyByteArray_FromStringAndSize(nullptr, size));
@@ -223,6 +226,43 @@ void fill(Ref &bytes, const binocle_image &im) {
     }
 }
 
+[[noreturn]] void raised(const Module &m, const char *call, binocle_result code) {
+    throw Error(code, m.file + ": " + call + " raised " + pythonError(m.shim));
+}
+
+// A numpy array of a copy of a host image (GRAY8, BGR8 as RGB, RGB8, GRAY16, FLOAT32).
+PyObject *arrayOf(const Module &m, const binocle_image &im) {
+    const int bpp = binocle::sdk::bytesPerPixel(im.format);
+    if (bpp == 0 || !im.data || im.width < 1 || im.height < 1 || im.stride_bytes < im.width * bpp) return Py_NewRef(Py_None);
+    Ref bytes;
+    fill(bytes, im);
+    if (!bytes) return nullptr;
+    const int channels = channelsOf(im);
+    return PyObject_CallMethod(m.shim, "image", "Oiiii", bytes.get(), im.height, im.width, channels, bpp / channels);
+}
+
+// An instance of the module's class, given the checked settings.
+Ref makeInstance(const Module &m, const binocle::sdk::Params &p) {
+    const binocle::sdk::CheckedParams c(p, m.params, m.name);
+    Gil gil;
+    Ref values(PyDict_New()), types(PyDict_New());
+    for (const auto &[name, type] : m.types) {
+        Ref v;
+        switch (type) {
+        case BINOCLE_PARAM_BOOL: v = Ref(PyBool_FromLong(c.boolean(name))); break;
+        case BINOCLE_PARAM_INT: v = Ref(PyLong_FromLongLong(c.integer(name))); break;
+        case BINOCLE_PARAM_DOUBLE: v = Ref(PyFloat_FromDouble(c.real(name))); break;
+        default: v = Ref(PyUnicode_FromString(c.string(name).c_str())); break;
+        }
+        Ref t(PyLong_FromLong(type));
+        PyDict_SetItemString(values.get(), name.c_str(), v.get());
+        PyDict_SetItemString(types.get(), name.c_str(), t.get());
+    }
+    Ref instance(PyObject_CallMethod(m.shim, "create", "OOO", m.cls, values.get(), types.get()));
+    if (!instance) raised(m, "__init__", BINOCLE_ERR_INVALID_ARGUMENT);
+    return instance;
+}
+
 // Disparities that are NaN or infinite in a row (exponent bits all set), in a loop the
 // compiler vectorises.
 size_t nonFiniteIn(const float *row, int n) {
@@ -239,25 +279,7 @@ class PyMatcher : public binocle::sdk::Matcher {
 public:
     static std::vector<binocle_param_desc> parameters() { return module().params; }
 
-    PyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &) : m_(module()) {
-        const binocle::sdk::CheckedParams c(p, m_.params, m_.name);
-        Gil gil;
-        Ref values(PyDict_New()), types(PyDict_New());
-        for (const auto &[name, type] : m_.types) {
-            Ref v;
-            switch (type) {
-            case BINOCLE_PARAM_BOOL: v = Ref(PyBool_FromLong(c.boolean(name))); break;
-            case BINOCLE_PARAM_INT: v = Ref(PyLong_FromLongLong(c.integer(name))); break;
-            case BINOCLE_PARAM_DOUBLE: v = Ref(PyFloat_FromDouble(c.real(name))); break;
-            default: v = Ref(PyUnicode_FromString(c.string(name).c_str())); break;
-            }
-            Ref t(PyLong_FromLong(type));
-            PyDict_SetItemString(values.get(), name.c_str(), v.get());
-            PyDict_SetItemString(types.get(), name.c_str(), t.get());
-        }
-        instance_ = Ref(PyObject_CallMethod(m_.shim, "create", "OOO", m_.cls, values.get(), types.get()));
-        if (!instance_) fail("__init__", BINOCLE_ERR_INVALID_ARGUMENT);
-    }
+    PyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &) : m_(module()), instance_(makeInstance(m_, p)) {}
 
     ~PyMatcher() override {
         Gil gil;
@@ -269,7 +291,7 @@ public:
     void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) override {
         checkInputs(left, right, disparity);
         Gil gil;
-        const int channels = left.format == BINOCLE_PIXEL_GRAY8 ? 1 : 3;
+        const int channels = channelsOf(left);
         fill(leftBytes_, left);
         fill(rightBytes_, right);
         if (!leftBytes_ || !rightBytes_) fail("compute", BINOCLE_ERR_INTERNAL);
@@ -290,9 +312,7 @@ public:
     }
 
 private:
-    [[noreturn]] void fail(const char *call, binocle_result code) const {
-        throw Error(code, m_.file + ": " + call + " raised " + pythonError(m_.shim));
-    }
+    [[noreturn]] void fail(const char *call, binocle_result code) const { raised(m_, call, code); }
 
     static void checkInputs(const binocle_image &l, const binocle_image &r, const binocle_image &d) {
         auto fmt = [](int32_t f) { return f == BINOCLE_PIXEL_GRAY8 || f == BINOCLE_PIXEL_BGR8 || f == BINOCLE_PIXEL_RGB8; };
@@ -372,6 +392,86 @@ private:
     Ref instance_, leftBytes_, rightBytes_;
 };
 
+// An evaluator: evaluate(frame) gets a Frame of numpy copies and returns its figures.
+class PyEvaluator : public binocle::sdk::Evaluator {
+public:
+    static std::vector<binocle_param_desc> parameters() { return module().params; }
+
+    PyEvaluator(const binocle::sdk::Params &p, binocle::sdk::Host &host)
+        : m_(module()), host_(host), instance_(makeInstance(m_, p)) {}
+
+    ~PyEvaluator() override {
+        Gil gil;
+        instance_ = Ref();
+    }
+
+    void evaluate(const binocle_eval_input &in) override {
+        Gil gil;
+        Ref fields(PyDict_New());
+        auto put = [&](const char *key, PyObject *value) {
+            if (!value) raised(m_, "evaluate", BINOCLE_ERR_INTERNAL);
+            PyDict_SetItemString(fields.get(), key, value);
+            Py_DECREF(value);
+        };
+        auto text = [](const char *s) { return s ? PyUnicode_FromString(s) : Py_NewRef(Py_None); };
+        auto image = [&](const binocle_image *im) { return im ? arrayOf(m_, *im) : Py_NewRef(Py_None); };
+        put("left", image(in.rectified_left));
+        put("right", image(in.rectified_right));
+        put("disparity", image(in.disparity));
+        Ref extras(PyDict_New());
+        if (const binocle_stereo_frame *f = in.frame) {
+            put("sequence", PyLong_FromUnsignedLongLong(f->sequence));
+            put("metadata", text(f->metadata));
+            for (int32_t i = 0; i < f->extra_count && f->extras; ++i) {
+                Ref a(arrayOf(m_, f->extras[i].image));
+                if (!a || !f->extras[i].name) raised(m_, "evaluate", BINOCLE_ERR_INTERNAL);
+                PyDict_SetItemString(extras.get(), f->extras[i].name, a.get());
+            }
+        }
+        put("extras", extras.release());
+        if (const binocle_cloud *c = in.cloud; c && c->xyz && c->count > 0) {
+            const binocle_image xyz = binocle::sdk::makeImage(3, static_cast<int32_t>(c->count), BINOCLE_PIXEL_FLOAT32, c->xyz);
+            put("cloud", arrayOf(m_, xyz));
+        } else {
+            put("cloud", Py_NewRef(Py_None));
+        }
+        put("calibration_yaml", text(in.calibration_yaml));
+        put("rig_yaml", text(in.rig_yaml));
+        put("output_dir", text(in.output_dir));
+        const bool range = BINOCLE_EVAL_INPUT_HAS(in, num_disparities) && in.num_disparities > 0;
+        put("disparity_range", range ? Py_BuildValue("(ii)", in.min_disparity, in.num_disparities) : Py_NewRef(Py_None));
+        const bool pose = BINOCLE_EVAL_INPUT_HAS(in, inclination_deg) && in.ground_pose_known;
+        put("ground_pose", pose ? Py_BuildValue("(dd)", in.camera_height_mm, in.inclination_deg) : Py_NewRef(Py_None));
+        Ref frame(PyObject_CallMethod(m_.shim, "frame", "O", fields.get()));
+        if (!frame) raised(m_, "evaluate", BINOCLE_ERR_INTERNAL);
+        Ref result(PyObject_CallMethod(instance_.get(), "evaluate", "O", frame.get()));
+        if (!result) raised(m_, "evaluate", BINOCLE_ERR_INTERNAL);
+        report(result.get(), "evaluate");
+    }
+
+    void finish() override {
+        Gil gil;
+        if (!PyObject_HasAttrString(instance_.get(), "finish")) return;
+        Ref result(PyObject_CallMethod(instance_.get(), "finish", nullptr));
+        if (!result) raised(m_, "finish", BINOCLE_ERR_INTERNAL);
+        report(result.get(), "finish");
+    }
+
+private:
+    void report(PyObject *result, const char *call) {
+        Ref list(PyObject_CallMethod(m_.shim, "figures", "O", result));
+        if (!list) throw Error(BINOCLE_ERR_INTERNAL, m_.file + ": " + call + " " + pythonError(m_.shim));
+        for (Py_ssize_t i = 0; i < PyList_Size(list.get()); ++i) {
+            PyObject *f = PyList_GetItem(list.get(), i);
+            host_.metric(textOf(PyTuple_GetItem(f, 0)), PyFloat_AsDouble(PyTuple_GetItem(f, 1)), textOf(PyTuple_GetItem(f, 2)));
+        }
+    }
+
+    Module &m_;
+    binocle::sdk::Host &host_;
+    Ref instance_;
+};
+
 } // namespace
 
 // The init symbol: the table of the kind the module declares, or NULL (and why, on
@@ -383,7 +483,10 @@ extern "C" BINOCLE_PLUGIN_EXPORT const binocle_plugin_header *binocle_plugin_ini
             std::fprintf(stderr, "binocle python plugin: %s\n", m.failure.c_str());
             return nullptr;
         }
-        return &binocle::sdk::detail::matcherTable<PyMatcher>(m.name.c_str(), m.version.c_str(), m.description.c_str())->header;
+        namespace d = binocle::sdk::detail;
+        if (m.kind == "evaluator")
+            return &d::evaluatorTable<PyEvaluator>(m.name.c_str(), m.version.c_str(), m.description.c_str())->header;
+        return &d::matcherTable<PyMatcher>(m.name.c_str(), m.version.c_str(), m.description.c_str())->header;
     } catch (...) {
         return nullptr;
     }

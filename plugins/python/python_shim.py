@@ -10,7 +10,8 @@ import traceback
 
 import numpy
 
-KINDS = ("matcher",)
+KINDS = ("matcher", "evaluator")
+DTYPES = {1: numpy.uint8, 2: numpy.uint16, 4: numpy.float32}  # bytes per channel value -> dtype
 # Setting types: the YAML words of binocle_param_desc's types (BINOCLE_PARAM_*).
 TYPES = {"bool": 1, "int": 2, "float": 3, "string": 4, "enum": 5, "path": 6, "yaml": 7,
          "int_list": 8, "float_list": 9}
@@ -96,8 +97,9 @@ def describe(cls, name):
     for attribute in ("version", "description"):
         if not isinstance(getattr(cls, attribute, None), str):
             raise PluginDefinitionError(f"the class has no '{attribute}' string")
-    if not callable(getattr(cls, "compute", None)):
-        raise PluginDefinitionError("the class has no compute(left, right) method")
+    method = "compute(left, right)" if kind == "matcher" else "evaluate(frame)"
+    if not callable(getattr(cls, method.split("(")[0], None)):
+        raise PluginDefinitionError(f"the class of a {kind} has no {method} method")
     settings = getattr(cls, "settings", [])
     return kind, cls.version, cls.description, [_setting(i, s) for i, s in enumerate(settings)]
 
@@ -117,10 +119,40 @@ def create(cls, values, types):
     return cls(values)
 
 
-def image(data, height, width, channels):
+def image(data, height, width, channels, item=1):
     """A numpy view on the bytes the bridge copied (Python owns them: keep it if you like)."""
-    array = numpy.frombuffer(data, dtype=numpy.uint8)
+    array = numpy.frombuffer(data, dtype=DTYPES[item])
     return array.reshape((height, width) if channels == 1 else (height, width, channels))
+
+
+class Frame:
+    """What an evaluator's evaluate(frame) receives (see sdk/README.md)."""
+
+    def __repr__(self):
+        return "Frame(" + ", ".join(sorted(vars(self))) + ")"
+
+
+def frame(fields):
+    f = Frame()
+    for key, value in fields.items():
+        setattr(f, key, value)
+    return f
+
+
+def figures(result):
+    """evaluate's or finish's result as [(name, value, unit)]: a dict name -> value or
+    (value, unit), or None."""
+    if result is None:
+        return []
+    if not isinstance(result, dict):
+        raise TypeError(f"returned a {type(result).__name__}; expected a dict of figures (name -> value or (value, unit))")
+    out = []
+    for name, value in result.items():
+        unit = ""
+        if isinstance(value, tuple):
+            value, unit = value
+        out.append((str(name), float(value), str(unit)))
+    return out
 
 
 def disparity_range(instance):
