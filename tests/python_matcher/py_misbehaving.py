@@ -16,11 +16,17 @@ class Misbehaving:
     settings = [
         {"name": "behaviour", "type": "enum", "default": "zeros",
          "choices": ["zeros", "fixed_point", "raise", "wrong_shape", "wrong_dtype", "not_an_array", "nan", "hang",
-                     "crash", "raise_in_init"],
+                     "crash", "raise_in_init", "echo_settings"],
          "help": "what compute does: zeros (all invalid, one array reused), fixed_point (int16 x 16: disparity 5), raise, "
-                 "wrong_shape, wrong_dtype, not_an_array, nan, hang (never returns), crash (abort), raise_in_init"},
+                 "wrong_shape, wrong_dtype, not_an_array, nan, hang (never returns), crash (abort), raise_in_init, "
+                 "echo_settings (raises with the settings it received)"},
         {"name": "num_disparities", "type": "int", "default": 16, "min": 1, "multiple_of": 16, "unit": "px",
          "help": "what disparity_range answers"},
+        {"name": "weights", "type": "float_list", "default": [1.0, 2.5], "help": "a list, for echo_settings"},
+        {"name": "steps", "type": "int_list", "default": [], "help": "a list, for echo_settings"},
+        {"name": "smooth", "type": "bool", "default": False, "help": "a flag, for echo_settings"},
+        {"name": "label", "type": "string", "default": "none", "help": "a text, for echo_settings"},
+        {"name": "gain", "type": "float", "default": 0.5, "min": 0, "max": 1, "help": "a number, for echo_settings"},
     ]
 
     def __init__(self, settings):
@@ -28,6 +34,7 @@ class Misbehaving:
         if self.behaviour == "raise_in_init":
             raise RuntimeError("fixture: refusing to be made")
         self.num_disparities = settings["num_disparities"]
+        self.settings = settings
 
     def disparity_range(self):
         return (0, self.num_disparities)
@@ -54,6 +61,8 @@ class Misbehaving:
                 time.sleep(1)
         if b == "crash":
             os.abort()
+        if b == "echo_settings":
+            raise ValueError(repr(sorted(self.settings.items())))
         # zeros: made once per size, as a matcher that reuses its buffers would.
         if getattr(self, "zeros", None) is None or self.zeros.shape != (height, width):
             self.zeros = np.zeros((height, width), np.float32)

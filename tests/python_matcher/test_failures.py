@@ -2,6 +2,8 @@
 # Python matchers that go wrong (the py_misbehaving fixture): every failure is a clear
 # error naming the plugin, its file and what went wrong, and the run ends with its
 # summary; a crash or a hang is contained by `isolation: process`.
+import json
+import os
 import re
 import time
 
@@ -88,12 +90,22 @@ def test_settings_are_checked_before_it_runs(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_settings_reach_the_class_with_their_types(tmp_path):
+    _, error, _ = failed_run(tmp_path, "echo_settings", extra="steps: [3, -4], smooth: true, label: hello, gain: 1")
+    assert ("ValueError: [('behaviour', 'echo_settings'), ('gain', 1.0), ('label', 'hello'), ('num_disparities', 16), "
+            "('smooth', True), ('steps', [3, -4]), ('weights', [1.0, 2.5])]") in error, error
+
+
 def test_fixed_point_result_is_read_as_pixels_times_16(tmp_path):
-    out = str(tmp_path / "out")
-    r = binocle("run", SIM_RIG, "--frames", "1", "--out", out, "--set", misbehaving("fixed_point"))
-    assert r.returncode == 0, r.stderr
-    s = summary(out)
-    assert s["status"] != "failed", s
+    # int16 80 everywhere is disparity 5: every pixel valid (zeros: none).
+    ratios = {}
+    for behaviour in ("fixed_point", "zeros"):
+        out = str(tmp_path / behaviour)
+        r = binocle("run", SIM_RIG, "--frames", "1", "--out", out, "--set", misbehaving(behaviour))
+        assert r.returncode == 0, r.stderr
+        with open(os.path.join(out, "frames.jsonl")) as f:
+            ratios[behaviour] = json.loads(f.readline())["valid_pixel_ratio"]
+    assert ratios == {"fixed_point": 1.0, "zeros": 0.0}, ratios
 
 
 def test_plugins_refuses_broken_python_plugins():
