@@ -16,10 +16,10 @@ class Misbehaving:
     settings = [
         {"name": "behaviour", "type": "enum", "default": "zeros",
          "choices": ["zeros", "fixed_point", "raise", "wrong_shape", "wrong_dtype", "not_an_array", "nan", "hang",
-                     "crash", "raise_in_init", "echo_settings"],
+                     "crash", "raise_in_init", "echo_settings", "leak"],
          "help": "what compute does: zeros (all invalid, one array reused), fixed_point (int16 x 16: disparity 5), raise, "
                  "wrong_shape, wrong_dtype, not_an_array, nan, hang (never returns), crash (abort), raise_in_init, "
-                 "echo_settings (raises with the settings it received)"},
+                 "echo_settings (raises with the settings it received), leak (keeps 64 MB more each call)"},
         {"name": "num_disparities", "type": "int", "default": 16, "min": 1, "multiple_of": 16, "unit": "px",
          "help": "what disparity_range answers"},
         {"name": "weights", "type": "float_list", "default": [1.0, 2.5], "help": "a list, for echo_settings"},
@@ -61,6 +61,8 @@ class Misbehaving:
                 time.sleep(1)
         if b == "crash":
             os.abort()
+        if b == "leak":
+            self.kept = getattr(self, "kept", []) + [np.ones(64 << 20, np.uint8)]
         if b == "echo_settings":
             raise ValueError(repr(sorted(self.settings.items())))
         # zeros: made once per size, as a matcher that reuses its buffers would.

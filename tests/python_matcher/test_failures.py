@@ -5,11 +5,12 @@
 import json
 import os
 import re
+import subprocess
 import time
 
 import pytest
 
-from common import SIM_RIG, binocle, misbehaving, summary
+from common import CLI, SIM_RIG, binocle, misbehaving, summary
 
 FIXTURE = "binocle_py_misbehaving.py"
 
@@ -80,6 +81,48 @@ def test_crash_restarts_as_configured(tmp_path):
     s = summary(out)
     assert s["status"] == "ok" and s["isolation"]["matcher"] == {"plugin": "py_misbehaving", "restarts": 1,
                                                                  "lost_calls": 1}, s
+
+
+def rss_mb(pid):
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return int(re.search(r"VmRSS:\s+(\d+)", f.read()).group(1)) / 1024
+    except (OSError, AttributeError):
+        return 0.0
+
+
+def children(pid):
+    found = []
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                if entry.isdigit() and int(f.read().rsplit(")", 1)[1].split()[1]) == pid:
+                    found.append(int(entry))
+        except OSError:
+            pass
+    return found
+
+
+def peak_rss(tmp_path, behaviour):
+    """(Binocle's peak RSS, its helper processes' peak RSS) in MB over a 6-frame run."""
+    out = str(tmp_path / behaviour)
+    p = subprocess.Popen([CLI, "run", SIM_RIG, "--out", out, "--set", "source.frames=6", "--set",
+                          misbehaving(behaviour, True)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    host = helpers = 0.0
+    while p.poll() is None:
+        host = max(host, rss_mb(p.pid))
+        helpers = max([helpers] + [rss_mb(c) for c in children(p.pid)])
+        time.sleep(0.02)
+    assert p.returncode == 0 and summary(out)["status"] == "ok", p.stderr.read()
+    return host, helpers
+
+
+def test_leak_stays_in_the_helper_process(tmp_path):
+    # 6 frames x 64 MB kept by compute: the helper grows by them, Binocle does not.
+    host_leak, helper_leak = peak_rss(tmp_path, "leak")
+    host_zeros, helper_zeros = peak_rss(tmp_path, "zeros")
+    assert helper_leak > helper_zeros + 200, (helper_leak, helper_zeros)
+    assert host_leak < host_zeros + 50, (host_leak, host_zeros)
 
 
 def test_settings_are_checked_before_it_runs(tmp_path):
