@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,9 @@ struct Module {
     std::vector<binocle_param_desc> params;
     std::vector<std::pair<std::string, int32_t>> types;
     PyObject *shim = nullptr;  // _binocle_bridge, never released
-    PyObject *cls = nullptr;   // the plugin's class, never released
+    PyObject *declared = nullptr; // describe()'s answer for the table read from the source
+    PyObject *cls = nullptr;   // the plugin's class once imported, never released
+    std::mutex importing;      // the first instance imports the module
     std::string failure;       // why loading failed (then the init symbol returns NULL)
 };
 
@@ -152,11 +155,12 @@ void load(Module &m) {
     Ref shim(code ? PyImport_ExecCodeModule("_binocle_bridge", code.get()) : nullptr);
     if (!shim) throw Error(BINOCLE_ERR_INTERNAL, "python bridge: its shim does not load: " + pythonError(nullptr));
     m.shim = shim.release();
-    Ref cls(PyObject_CallMethod(m.shim, "load", "ss", m.file.c_str(), m.name.c_str()));
-    if (!cls) throw Error(BINOCLE_ERR_INTERNAL, "cannot load " + m.file + ": " + pythonError(m.shim));
-    Ref info(PyObject_CallMethod(m.shim, "describe", "Os", cls.get(), m.name.c_str()));
+    // The table from the source's syntax tree: nothing of the plugin runs before `create`.
+    Ref declared(PyObject_CallMethod(m.shim, "read_table", "ss", m.file.c_str(), m.name.c_str()));
+    if (!declared) throw Error(BINOCLE_ERR_INTERNAL, "cannot read " + m.file + ": " + pythonError(m.shim));
+    Ref info(PyObject_CallMethod(m.shim, "describe", "Os", declared.get(), m.name.c_str()));
     if (!info) throw Error(BINOCLE_ERR_INTERNAL, m.file + ": " + pythonError(m.shim));
-    m.cls = cls.release();
+    m.declared = Py_NewRef(info.get());
     m.kind = textOf(PyTuple_GetItem(info.get(), 0));
     m.version = textOf(PyTuple_GetItem(info.get(), 1));
     m.description = textOf(PyTuple_GetItem(info.get(), 2));
@@ -241,10 +245,29 @@ PyObject *arrayOf(const Module &m, const binocle_image &im) {
     return PyObject_CallMethod(m.shim, "image", "Oiiii", bytes.get(), im.height, im.width, channels, bpp / channels);
 }
 
+// The module imported (its code runs now, in the process that makes an instance), and
+// its class checked against the table the host was given.
+void importModule(Module &m) {
+    Ref cls(PyObject_CallMethod(m.shim, "load", "ss", m.file.c_str(), m.name.c_str()));
+    if (!cls) throw Error(BINOCLE_ERR_INTERNAL, "cannot load " + m.file + ": " + pythonError(m.shim));
+    Ref info(PyObject_CallMethod(m.shim, "describe", "Os", cls.get(), m.name.c_str()));
+    if (!info) throw Error(BINOCLE_ERR_INTERNAL, m.file + ": " + pythonError(m.shim));
+    const int same = PyObject_RichCompareBool(info.get(), m.declared, Py_EQ);
+    if (same != 1) {
+        PyErr_Clear();
+        throw Error(BINOCLE_ERR_INTERNAL, m.file + ": the imported class's name, kind, version, description or "
+                                          "settings differ from the literals of its source (set them as literals "
+                                          "in the class body, not at run time)");
+    }
+    m.cls = cls.release();
+}
+
 // An instance of the module's class, given the checked settings.
-Ref makeInstance(const Module &m, const binocle::sdk::Params &p) {
+Ref makeInstance(Module &m, const binocle::sdk::Params &p) {
     const binocle::sdk::CheckedParams c(p, m.params, m.name);
+    std::lock_guard<std::mutex> lock(m.importing); // taken before the GIL, never while holding it
     Gil gil;
+    if (!m.cls) importModule(m);
     Ref values(PyDict_New()), types(PyDict_New());
     for (const auto &[name, type] : m.types) {
         Ref v;

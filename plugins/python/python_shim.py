@@ -1,17 +1,18 @@
 # SPDX-License-Identifier: MIT
-# The Python half of the bridge (python_bridge.cpp): loads a Python plugin's module,
-# reads its class's table, makes instances and calls them. Compiled into the bridge as
+# The Python half of the bridge (python_bridge.cpp): reads a Python plugin's table from
+# its source without running it, imports the module when the first instance is made,
+# makes instances and calls them. Compiled into the bridge as
 # text (it runs in the embedded interpreter as module `_binocle_bridge`), so that the
 # rules of a Python plugin's class live in one place that Python programmers can read.
+import ast
 import importlib.util
 import os
 import sys
 import traceback
 
-import numpy
-
 KINDS = ("matcher", "evaluator")
-DTYPES = {1: numpy.uint8, 2: numpy.uint16, 4: numpy.float32}  # bytes per channel value -> dtype
+TABLE = ("name", "kind", "version", "description", "settings")
+DTYPES = {1: "uint8", 2: "uint16", 4: "float32"}  # bytes per channel value -> dtype
 # Setting types: the YAML words of binocle_param_desc's types (BINOCLE_PARAM_*).
 TYPES = {"bool": 1, "int": 2, "float": 3, "string": 4, "enum": 5, "path": 6, "yaml": 7,
          "int_list": 8, "float_list": 9}
@@ -32,6 +33,41 @@ def _yaml_text(value):
     if isinstance(value, float):
         return repr(value)
     return str(value)
+
+
+class Declared:
+    """The class as its source declares it: the table's attributes (literals) and the
+    names of its methods, read without running the module."""
+
+
+def read_table(path, name):
+    """The class that `binocle_plugin = <class>` names, read from the source's syntax
+    tree: opening a plugin (binocle plugins, view, experiment) runs none of its code."""
+    with open(path, encoding="utf-8") as f:
+        tree = ast.parse(f.read(), path)
+    target = None
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "binocle_plugin" for t in node.targets):
+            if not isinstance(node.value, ast.Name):
+                raise PluginDefinitionError(f"{path}:{node.lineno}: binocle_plugin must name a class of this file")
+            target = node.value.id
+    if target is None:
+        raise PluginDefinitionError("the module has no line 'binocle_plugin = <class>' (the plugin's class)")
+    classes = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == target]
+    if not classes:
+        raise PluginDefinitionError(f"binocle_plugin = {target}: no class {target} at the top of this file")
+    declared = Declared()
+    for node in classes[-1].body:
+        if isinstance(node, ast.FunctionDef):
+            setattr(declared, node.name, len)  # a callable stands for the method
+        elif isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name) \
+                and node.targets[0].id in TABLE:
+            try:
+                setattr(declared, node.targets[0].id, ast.literal_eval(node.value))
+            except ValueError:
+                raise PluginDefinitionError(f"{path}:{node.lineno}: {node.targets[0].id} must be a literal (the table "
+                                            "is read without running the module)") from None
+    return declared
 
 
 def load(path, name):
@@ -121,6 +157,7 @@ def create(cls, values, types):
 
 def image(data, height, width, channels, item=1):
     """A numpy view on the bytes the bridge copied (Python owns them: keep it if you like)."""
+    import numpy
     array = numpy.frombuffer(data, dtype=DTYPES[item])
     return array.reshape((height, width) if channels == 1 else (height, width, channels))
 

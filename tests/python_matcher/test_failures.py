@@ -151,10 +151,31 @@ def test_fixed_point_result_is_read_as_pixels_times_16(tmp_path):
     assert ratios == {"fixed_point": 1.0, "zeros": 0.0}, ratios
 
 
-def test_plugins_refuses_broken_python_plugins():
+def test_plugins_reads_tables_without_running_modules():
     r = binocle("plugins")
     assert r.returncode == 0, r.stderr
     listing = r.stdout + r.stderr
+    # The SDK's checker refuses a bad table, as a C plugin's.
     assert re.search(r"py_bad_table.*window_px.*default '4' is not odd", listing), listing
-    assert "binocle_py_import_error.so" in listing
-    assert "ImportError: fixture: a module this plugin needs is missing" in r.stderr, r.stderr
+    # A module that raises on import is listed: its table is read without running it.
+    assert re.search(r"py_import_error\s+matcher\s+0\.1\.0", r.stdout), r.stdout
+    assert "ImportError" not in listing
+    # A table that is not literals is refused, the line said on stderr.
+    assert "binocle_py_dynamic_table.so: init returned no table" in r.stdout, r.stdout
+    assert re.search(r"binocle_py_dynamic_table\.py:10: version must be a literal", r.stderr), r.stderr
+
+
+def test_class_changed_at_import_fails_create(tmp_path):
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", str(tmp_path / "out"), "--set",
+                "matcher={plugin: py_table_changed}")
+    assert r.returncode == 1, r.stderr
+    assert "settings differ from the literals of its source" in r.stderr, r.stderr
+
+
+def test_module_that_cannot_be_imported_fails_create(tmp_path):
+    r = binocle("run", SIM_RIG, "--frames", "1", "--out", str(tmp_path / "out"), "--set",
+                "matcher={plugin: py_import_error}")
+    assert r.returncode == 1, r.stderr
+    assert "create failed" in r.stderr and "cannot load" in r.stderr
+    assert re.search(r"ImportError: fixture: a module this plugin needs is missing \(at \S+binocle_py_import_error\.py:7 "
+                     r"in <module>\)", r.stderr), r.stderr
