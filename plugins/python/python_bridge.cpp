@@ -205,9 +205,10 @@ int channelsOf(const binocle_image &im) {
     return im.format == BINOCLE_PIXEL_BGR8 || im.format == BINOCLE_PIXEL_RGB8 ? 3 : 1;
 }
 
-// Fills bytes Python owns from a host image: BGR8 swapped to RGB, others as they are.
-// The last call's bytes are reused when nothing in Python refers to them any more (no
-// page faults on fresh memory each frame); a matcher that kept its input gets new ones.
+// Fills bytes Python owns from a host image, row by row as they are (a BGR8 image is
+// shown to Python in RGB order by a reversed view: shim.image). The last call's bytes
+// are reused when nothing in Python refers to them any more (no page faults on fresh
+// memory each frame); a matcher that kept its input gets new ones.
 void fill(Ref &bytes, const binocle_image &im) {
     const size_t row = static_cast<size_t>(im.width) * binocle::sdk::bytesPerPixel(im.format);
     const auto size = static_cast<Py_ssize_t>(row * im.height);
@@ -215,19 +216,8 @@ void fill(Ref &bytes, const binocle_image &im) {
         bytes = Ref(PyByteArray_FromStringAndSize(nullptr, size));
     if (!bytes) return;
     auto *out = reinterpret_cast<uint8_t *>(PyByteArray_AsString(bytes.get()));
-    for (int y = 0; y < im.height; ++y) {
-        const auto *in = static_cast<const uint8_t *>(im.data) + static_cast<size_t>(y) * im.stride_bytes;
-        uint8_t *o = out + y * row;
-        if (im.format == BINOCLE_PIXEL_BGR8) {
-            for (int x = 0; x < im.width; ++x) {
-                o[3 * x] = in[3 * x + 2];
-                o[3 * x + 1] = in[3 * x + 1];
-                o[3 * x + 2] = in[3 * x];
-            }
-        } else {
-            std::memcpy(o, in, row);
-        }
-    }
+    for (int y = 0; y < im.height; ++y)
+        std::memcpy(out + y * row, static_cast<const uint8_t *>(im.data) + static_cast<size_t>(y) * im.stride_bytes, row);
 }
 
 [[noreturn]] void raised(const Module &m, const char *call, binocle_result code) {
@@ -242,7 +232,8 @@ PyObject *arrayOf(const Module &m, const binocle_image &im) {
     fill(bytes, im);
     if (!bytes) return nullptr;
     const int channels = channelsOf(im);
-    return PyObject_CallMethod(m.shim, "image", "Oiiii", bytes.get(), im.height, im.width, channels, bpp / channels);
+    return PyObject_CallMethod(m.shim, "image", "Oiiiii", bytes.get(), im.height, im.width, channels, bpp / channels,
+                               im.format == BINOCLE_PIXEL_BGR8);
 }
 
 // The module imported (its code runs now, in the process that makes an instance), and
@@ -318,8 +309,10 @@ public:
         fill(leftBytes_, left);
         fill(rightBytes_, right);
         if (!leftBytes_ || !rightBytes_) fail("compute", BINOCLE_ERR_INTERNAL);
-        Ref l(PyObject_CallMethod(m_.shim, "image", "Oiii", leftBytes_.get(), left.height, left.width, channels));
-        Ref r(l ? PyObject_CallMethod(m_.shim, "image", "Oiii", rightBytes_.get(), left.height, left.width, channels) : nullptr);
+        const int bgr = left.format == BINOCLE_PIXEL_BGR8;
+        Ref l(PyObject_CallMethod(m_.shim, "image", "Oiiiii", leftBytes_.get(), left.height, left.width, channels, 1, bgr));
+        Ref r(l ? PyObject_CallMethod(m_.shim, "image", "Oiiiii", rightBytes_.get(), left.height, left.width, channels, 1, bgr)
+                : nullptr);
         if (!r) fail("compute", BINOCLE_ERR_INTERNAL);
         Ref result(PyObject_CallMethod(instance_.get(), "compute", "OO", l.get(), r.get()));
         if (!result) fail("compute", BINOCLE_ERR_INTERNAL);

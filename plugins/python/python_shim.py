@@ -155,11 +155,13 @@ def create(cls, values, types):
     return cls(values)
 
 
-def image(data, height, width, channels, item=1):
-    """A numpy view on the bytes the bridge copied (Python owns them: keep it if you like)."""
+def image(data, height, width, channels, item=1, bgr=False):
+    """A numpy view on the bytes the bridge copied (Python owns them: keep it if you
+    like); a BGR image as a view in RGB order (channels reversed, no copy)."""
     import numpy
     array = numpy.frombuffer(data, dtype=DTYPES[item])
-    return array.reshape((height, width) if channels == 1 else (height, width, channels))
+    array = array.reshape((height, width) if channels == 1 else (height, width, channels))
+    return array[:, :, ::-1] if bgr else array
 
 
 class Frame:

@@ -56,6 +56,17 @@ def test_bridge_joins_the_running_interpreter():
     # The shifted copy: disparity 8 where the window fits and the match exists.
     inner = disparity[10:-10, 20:-10]
     assert abs(np.median(inner) - 8) < 0.05 and (np.abs(inner - 8) < 0.5).mean() > 0.9, inner
+    # Colour: a BGR8 pair reaches Python in RGB order, so it matches as the same pair in RGB8.
+    colour = rng.integers(0, 256, (120, 200, 3), dtype=np.uint8)
+    rgb_l, rgb_r = np.ascontiguousarray(colour[:, :160]), np.ascontiguousarray(colour[:, 8:168])
+    by_format = {}
+    for fmt, (l, r) in {3: (rgb_l[..., ::-1], rgb_r[..., ::-1]), 4: (rgb_l, rgb_r)}.items():
+        l, r = np.ascontiguousarray(l), np.ascontiguousarray(r)
+        d = np.zeros((120, 160), np.float32)
+        assert api.compute(handle, image(l, fmt), image(r, fmt), image(d, 5)) == 0, api.last_error(handle)
+        by_format[fmt] = d
+    assert np.array_equal(by_format[3], by_format[4])
+    assert abs(np.median(by_format[4][10:-10, 20:-10]) - 8) < 0.05
     api.destroy(handle)
     # The module the bridge imported is this interpreter's: same sys.modules.
     import sys
