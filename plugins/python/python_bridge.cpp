@@ -118,7 +118,8 @@ std::string textOf(PyObject *o) {
 }
 
 // Starts the interpreter unless the process has one (the `binocle` Python module, or a
-// second Python plugin), imports the shim and the plugin's module and reads its table.
+// second Python plugin), loads the shim and reads the plugin's table from its source
+// (the module itself is imported by the first instance: importModule).
 void load(Module &m) {
     const std::string so = fileOfThisLibrary();
     const std::string folder = so.substr(0, so.rfind('/') + 1);
