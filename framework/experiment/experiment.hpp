@@ -146,6 +146,10 @@ struct ExperimentResult {
 // "K/N" -> (K, N), 1 <= K <= N; throws binocle::Error naming the option and the value.
 std::pair<int, int> parseShard(const std::string &text);
 
+// The tests a run does: its shard's, and of those the ones `options.only` names. Throws
+// binocle::Error naming an id the experiment lacks, or when none is selected.
+std::vector<const ExperimentTest *> selectTests(const Experiment &e, const ExperimentOptions &options);
+
 // Joins the results.json of shards (or partial runs) of one experiment in `dirs` into
 // `out_dir`: the rows in the experiment's test order, the predictors' rho and the charts
 // recomputed over all of them, each test's folder copied. Throws when two folders hold

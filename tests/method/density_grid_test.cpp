@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 namespace binocle::test {
 namespace {
@@ -155,6 +157,18 @@ TEST(DensityRender, DrawsAReadablePictureAndWritesItWhole) {
     EXPECT_EQ(back.size(), img.size());
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
     EXPECT_THROW(writePngAtomic(dir.str("no/such/folder/x.png"), img), std::runtime_error);
+
+    // A symlink planted under the name the writer once used (PATH.tmp-<pid>) is never
+    // followed: its target stays untouched, and the picture still lands whole.
+    const std::string target = dir.str("target.txt");
+    writeText(target, "untouched");
+    const std::string planted = path + ".tmp-" + std::to_string(::getpid());
+    std::filesystem::create_symlink(target, planted);
+    writePngAtomic(path, img);
+    std::ifstream in(target);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "untouched");
+    EXPECT_TRUE(std::filesystem::is_symlink(planted));
+    EXPECT_EQ(cv::imread(path, cv::IMREAD_COLOR).size(), img.size());
 
     // The top view of an empty cloud is still a picture (axes, no cells).
     const cv::Mat empty = renderDensityView(binView(CloudView(), View::Top, spec));
