@@ -60,6 +60,11 @@ struct Experiment {
     std::string name, description;
     std::string rig_file; // the base rig
     YAML::Node rig;       // the base rig's tree
+    // The base rig's text and the rig_set: paths and values laid over it: each test's rig
+    // is parsed anew from them, so that its nodes keep their lines (YAML::Clone would
+    // put every one at line 1, column 1).
+    std::string rig_text;
+    std::vector<std::pair<std::string, std::string>> rig_set;
     int64_t frames = 1;
     std::vector<double> lenses_mm;            // the focal lengths the rig has
     double baseline_min_mm = 0, baseline_max_mm = 0;

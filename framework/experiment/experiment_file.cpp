@@ -5,6 +5,7 @@
 #include "experiment/test_rig.hpp"
 
 #include "config/rig_config.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "input/numbers.hpp"
 #include "input/text.hpp"
@@ -190,6 +191,7 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
     e.rig_file = rigPath.lexically_normal().string();
     if (!fs::exists(e.rig_file)) r.fail(root["rig"], "rig: file '" + e.rig_file + "' does not exist");
     e.rig = loadYaml(e.rig_file);
+    e.rig_text = readTextFile(e.rig_file);
     checkRigShape(e.rig, e.rig_file, r.where(root["rig"]));
     // rig_set: a partial rig laid over the base rig for every test (variants of a whole
     // experiment: `--set rig_set.source.image_width=640`).
@@ -202,6 +204,7 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
             }
             try {
                 applyOverride(e.rig, Override{path, yamlText(n), "rig_set: " + path});
+                e.rig_set.emplace_back(path, yamlText(n));
             } catch (const OverrideError &x) { // a mistake of the file (or of its --set rig_set...), named there
                 r.fail(n, std::string(x.what()) + " (laid over the base rig " + e.rig_file + ")");
             }
@@ -550,6 +553,7 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     e.rig_file = fs::absolute(rig_file, ec).lexically_normal().string();
     if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
     e.rig = loadYaml(e.rig_file);
+    e.rig_text = readTextFile(e.rig_file);
     checkRigShape(e.rig, e.rig_file, e.rig_file);
     e.bind = defaultBind(e.rig, host);
     for (size_t i = 0; i < tests.size(); ++i) {

@@ -6,6 +6,7 @@
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "input/numbers.hpp"
+#include "input/yaml_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -195,7 +196,13 @@ uint32_t Experiment::seedOf(int repeat) const {
 }
 
 YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t, int repeat) {
-    YAML::Node rig = YAML::Clone(e.rig);
+    YAML::Node rig;
+    if (e.rig_text.empty()) { // an experiment built in code
+        rig = YAML::Clone(e.rig);
+    } else {
+        rig = input::parseYaml(e.rig_text, e.rig_file); // read once at load: it parsed then
+        for (const auto &[path, value] : e.rig_set) applyOverride(rig, Override{path, value, "rig_set: " + path});
+    }
     if (const Lens *lens = lensFor(e, t.geometry.focal_length_mm))
         for (const auto &[path, value] : lens->set)
             applyOverride(rig, Override{path, value, "lens table " + e.lens_table_file + ": f = " + num(lens->focal_length_mm) + ": " + path});
