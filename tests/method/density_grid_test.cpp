@@ -56,29 +56,27 @@ TEST(DensityGrid, BinsPointsIntoTheThreeViews) {
 }
 
 TEST(DensityGrid, RefusesABadSpec) {
+    const auto why = [](const GridSpec &spec) -> std::string {
+        try {
+            spec.validate();
+        } catch (const std::invalid_argument &e) {
+            return e.what();
+        }
+        return "(accepted)";
+    };
     GridSpec spec;
     spec.cell_mm = 0;
     EXPECT_THROW(spec.validate(), std::invalid_argument);
     spec.cell_mm = 100;
     spec.x = {10, -10};
-    try {
-        spec.validate();
-        FAIL();
-    } catch (const std::invalid_argument &e) {
-        EXPECT_NE(std::string(e.what()).find("X extent"), std::string::npos) << e.what();
-    }
+    EXPECT_NE(why(spec).find("X extent"), std::string::npos) << why(spec);
     // 4.3e11 mm of X in 100 mm cells: 4.3e9 cells, past an int; counted before any cast.
     spec.x = {-2.15e11, 2.15e11};
-    try {
-        spec.validate();
-        FAIL();
-    } catch (const std::invalid_argument &e) {
-        EXPECT_NE(std::string(e.what()).find("top-view (X by Y) cells: expected at most 6.4e+07"), std::string::npos) << e.what();
-    }
-    // The front and side views count too (Z by X, Y by Z), not only the top view.
+    EXPECT_NE(why(spec).find("top-view (X by Y) cells: expected at most 6.4e+07"), std::string::npos) << why(spec);
+    // The front and side views count too (X by Z, Y by Z), not only the top view.
     spec.x = {-6000, 6000};
     spec.z = {0, 5e9};
-    EXPECT_THROW(spec.validate(), std::invalid_argument);
+    EXPECT_NE(why(spec).find("front-view (X by Z) cells"), std::string::npos) << why(spec);
 }
 
 // The E1 panel seen from the top: three columns of cubes, 1 m apart, at the panel's range.
