@@ -146,13 +146,13 @@ YAML::Node loadYaml(const std::string &file) {
 // calibration, `source: sim`) is named with what was expected, not with yaml-cpp's words.
 void checkRigShape(const YAML::Node &rig, const std::string &file, const std::string &namedAt) {
     const std::string expected = "expected a rig: a YAML map with source: {plugin: NAME, ...} and matcher: {plugin: NAME, ...}";
-    if (!rig.IsMap()) throw Error(namedAt + ": rig: " + file + " is not a rig (" + expected + ")");
+    if (!rig.IsMap()) throw Error(namedAt + ": " + file + " is not a rig (" + expected + ")");
     std::vector<std::string> keys;
     for (const auto &kv : rig) keys.push_back(kv.first.IsScalar() ? input::printable(kv.first.Scalar(), 40) : "(not a text)");
     for (const char *block : {"source", "matcher"}) {
         const YAML::Node b = rig[block];
         if (!b.IsDefined())
-            throw Error(namedAt + ": rig: " + file + " has no '" + block + "' block: " + expected + " (its top-level keys: " +
+            throw Error(namedAt + ": " + file + " has no '" + block + "' block: " + expected + " (its top-level keys: " +
                         (keys.empty() ? "none" : join(keys)) + ")");
         const std::string at = b.Mark().is_null() ? file : file + ":" + std::to_string(b.Mark().line + 1) + ":" +
                                                                std::to_string(b.Mark().column + 1);
@@ -192,7 +192,7 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
     if (!fs::exists(e.rig_file)) r.fail(root["rig"], "rig: file '" + e.rig_file + "' does not exist");
     e.rig = loadYaml(e.rig_file);
     e.rig_text = readTextFile(e.rig_file);
-    checkRigShape(e.rig, e.rig_file, r.where(root["rig"]));
+    checkRigShape(e.rig, e.rig_file, r.where(root["rig"]) + ": rig");
     // rig_set: a partial rig laid over the base rig for every test (variants of a whole
     // experiment: `--set rig_set.source.image_width=640`).
     if (YAML::Node rs = root["rig_set"]) {
@@ -554,7 +554,7 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
     e.rig = loadYaml(e.rig_file);
     e.rig_text = readTextFile(e.rig_file);
-    checkRigShape(e.rig, e.rig_file, e.rig_file);
+    checkRigShape(e.rig, e.rig_file, "--rig");
     e.bind = defaultBind(e.rig, host);
     for (size_t i = 0; i < tests.size(); ++i) {
         ExperimentTest t;
