@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "input/text.hpp"
 #include "report/chart.hpp"
 #include "report/web_files.hpp"
 
@@ -395,6 +396,18 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
     // it, as `calibrate --out` does: a file is never renamed over a folder.
     std::error_code isDir;
     const bool intoFolder = !outputText.empty() && (outputText.back() == '/' || fs::is_directory(outputText, isDir));
+    // Each row's test id names its folder test_<id>/, whose images are inlined: a file name,
+    // never a path out of DIR.
+    const auto &rows = results["tests"];
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const OJson &row = rows[i];
+        std::string why = "expected a text";
+        if (!row.is_object() || !row.contains("test") || !row["test"].is_string() ||
+            !input::isSafeName(row["test"].get<std::string>(), &why))
+            throw Error("report: " + resultsPath.string() + ": tests[" + std::to_string(i) + "].test " +
+                        (row.is_object() && row.contains("test") ? input::printable(row["test"].dump(), 60) : "(missing)") +
+                        " is not valid: " + why + " (the id of a test, which names its folder test_<id>/)");
+    }
     const std::string output = outputText.empty() ? (dir / "report.html").string()
                                : intoFolder       ? (fs::path(outputText) / "report.html").string()
                                                   : outputText;
