@@ -344,6 +344,8 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
         fs::path p = c.Scalar();
         if (p.is_relative()) p = fs::path(ctx.base_dir) / p;
         if (!fs::exists(p)) ctx.fail(c, "calibration", "file '" + p.string() + "' does not exist");
+        if (std::error_code ec; !fs::is_regular_file(p, ec))
+            ctx.fail(c, "calibration", "'" + p.string() + "' is not a file (expected an OpenCV FileStorage YAML calibration)");
         rig.calibration_file = p.lexically_normal().string();
     }
     if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
