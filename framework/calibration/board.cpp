@@ -3,13 +3,15 @@
 #include "calibration/board.hpp"
 
 #include "core/error.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <regex>
+#include <sstream>
 
 namespace binocle {
 
@@ -23,20 +25,32 @@ std::vector<cv::Point3f> BoardSpec::objectPoints() const {
 }
 
 BoardSpec BoardSpec::parse(const std::string &board, double square_mm) {
-    static const std::regex form(R"(\s*(\d{1,3})\s*[xX]\s*(\d{1,3})\s*)");
-    std::smatch m;
-    if (!std::regex_match(board, m, form))
-        throw Error("--board '" + board + "': expected COLSxROWS, the inner corners per row and per column, e.g. 9x6");
+    // COLSxROWS, each count read by the one number reader: "09x6" is refused like any
+    // number with a leading zero, not read as 9.
+    const auto x = board.find_first_of("xX");
+    const std::string shown = input::printable(board);
+    if (x == std::string::npos)
+        throw Error("--board '" + shown + "': expected COLSxROWS, the inner corners per row and per column, e.g. 9x6");
     BoardSpec b;
-    b.cols = std::stoi(m[1]);
-    b.rows = std::stoi(m[2]);
+    const std::pair<std::string, int *> parts[] = {{board.substr(0, x), &b.cols}, {board.substr(x + 1), &b.rows}};
+    for (const auto &[text, count] : parts) {
+        int64_t v = 0;
+        std::string why;
+        if (!input::parseInteger(text, v, &why, 0, 999))
+            throw Error("--board '" + shown + "': '" + input::printable(text) + "' is not valid: " + why +
+                        " (COLSxROWS, the inner corners per row and per column, e.g. 9x6)");
+        *count = static_cast<int>(v);
+    }
     if (b.cols < 2 || b.rows < 2)
-        throw Error("--board '" + board + "': a chessboard needs at least 2x2 inner corners");
+        throw Error("--board '" + shown + "': a chessboard needs at least 2x2 inner corners");
     if (b.cols == b.rows)
-        throw Error("--board '" + board +
+        throw Error("--board '" + shown +
                     "': a square pattern has no distinct orientation; use a board with different counts (e.g. 9x6)");
-    if (!(square_mm > 0) || !std::isfinite(square_mm))
-        throw Error("--square-mm " + std::to_string(square_mm) + ": expected the side of one square in mm, > 0");
+    if (!(square_mm > 0) || !std::isfinite(square_mm)) {
+        std::ostringstream shown; // as written ("-5"), not std::to_string's "-5.000000"
+        shown << square_mm;
+        throw Error("--square-mm " + shown.str() + ": expected the side of one square in mm, > 0");
+    }
     b.square_mm = square_mm;
     return b;
 }

@@ -49,25 +49,35 @@ std::string num(double v) {
     return os.str();
 }
 
-std::vector<double> numberList(const std::string &option, const std::string &text) {
+// An example of each list option's value, for its messages.
+std::string exampleOf(const std::string &option) {
+    return option == "--lenses" ? "2.8,4,8" : option == "--baselines" ? "100,150,190 or 100:200:10"
+                                          : option == "--band"        ? "5000,12000"
+                                                                      : "6000,12000";
+}
+
+// Numbers separated by commas, at least one: "" and "6000," are refused, not read as fewer.
+std::vector<double> numberList(const std::string &option, const std::string &text, char separator = ',') {
     std::vector<double> out;
-    std::stringstream ss(text);
-    for (std::string item; std::getline(ss, item, ',');) {
+    const std::string shown = option + " " + input::printable(text);
+    if (text.empty()) throw UsageError(shown + ": expected at least one number (e.g. " + exampleOf(option) + ")");
+    for (size_t start = 0;;) {
+        const size_t end = text.find(separator, start);
+        const std::string item = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
         double v = 0;
-        if (!input::parseReal(item, v)) // decimal and finite: no "nan", "inf" or "0x1p3"
-            throw UsageError(option + " " + input::printable(text) + ": '" + input::printable(item) +
-                        "' is not a number (expected e.g. 2.8,4,8)");
+        std::string why;
+        if (!input::parseReal(item, v, &why)) // decimal and finite: no "nan", "inf" or "0x1p3"
+            throw UsageError(shown + ": '" + input::printable(item) + "' is not valid: " + why + " (e.g. " + exampleOf(option) + ")");
         out.push_back(v);
+        if (end == std::string::npos) return out;
+        start = end + 1;
     }
-    return out;
 }
 
 // "100:200:10" (min:max:step) or a list "100,150,190".
 std::vector<double> baselines(const std::string &text) {
     if (text.find(':') == std::string::npos) return numberList("--baselines", text);
-    std::vector<double> p;
-    std::stringstream ss(text);
-    for (std::string item; std::getline(ss, item, ':');) p.push_back(numberList("--baselines", item).at(0));
+    const std::vector<double> p = numberList("--baselines", text, ':');
     if (p.size() != 3 || !(p[2] > 0) || p[1] < p[0]) throw UsageError("--baselines " + text + ": expected MIN:MAX:STEP in mm, e.g. 100:200:10");
     // Counted before anything is made: 1:1e9:1 would otherwise fill the memory.
     const double count = std::floor((p[1] - p[0]) / p[2] + 1e-9) + 1;

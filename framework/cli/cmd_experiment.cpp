@@ -38,7 +38,12 @@ int experiment(const ExperimentArgs &args) {
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
     // Everything is checked before the first test runs.
-    Experiment e = loadExperiment(args.file, host, args.set);
+    Experiment e;
+    try {
+        e = loadExperiment(args.file, host, args.set);
+    } catch (const OverrideError &x) {
+        throw UsageError(x.what()); // a bad --set is a bad value on the command line: exit 2
+    }
     if (args.check) {
         std::cout << "experiment " << e.name << ": " << e.tests.size() << " tests, rig " << e.rig_file << ": valid\n";
         return 0;
@@ -47,9 +52,14 @@ int experiment(const ExperimentArgs &args) {
     options.out_dir = args.out.empty() ? "out/" + e.name : args.out;
     options.progress = !args.quiet;
     options.replace = args.force;
-    if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
     for (const auto &id : args.tests)
         if (!id.empty()) options.only.push_back(id);
+    try { // --shard and --tests are values of the command line: a mistake there is exit 2
+        if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
+        selectTests(e, options);
+    } catch (const Error &x) {
+        throw UsageError(x.what());
+    }
     const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, args.force, "binocle experiment"});
     const ExperimentResult result = runExperiment(e, host, options);
     spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",

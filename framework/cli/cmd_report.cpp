@@ -39,7 +39,7 @@ Register reg{{"report", "an experiment's results as one self-contained HTML file
               [](CLI::App &app) -> Runner {
                   auto args = std::make_shared<ReportArgs>();
                   app.add_option("dir", args->dir, "the experiment's output folder")->type_name("DIR")->required();
-                  app.add_option("--output", args->output, "where to write (one experiment only; default DIR/report.html)")
+                  app.add_option("--output", args->output, "where to write (one experiment only; default DIR/report.html; a folder: report.html in it)")
                       ->type_name("FILE");
                   return [args] { return report(*args); };
               }}};

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `binocle view RIG.yaml`: the rig's pipeline with a live web page on this machine.
 #include "cli/command.hpp"
+#include "input/text.hpp"
 #include "viewer/viewer.hpp"
+#include "viewer/web_guard.hpp"
+
+#include <arpa/inet.h>
 
 #include <nlohmann/json.hpp>
 
@@ -16,16 +20,34 @@ struct ViewArgs {
     int64_t frames = -1;
 };
 
+// --bind and --allow-remote are read here, before any plugin opens: a mistake in them is
+// wrong usage (exit status 2), not a failed run.
+void checkBind(const viewer::ViewOptions &o) {
+    unsigned char bytes[16];
+    if (::inet_pton(AF_INET, o.address.c_str(), bytes) != 1 && ::inet_pton(AF_INET6, o.address.c_str(), bytes) != 1)
+        throw UsageError("--bind " + input::printable(o.address) + ": expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
+    if (const std::string refusal = viewer::remoteBindRefusal(o.address, o.allow_remote); !refusal.empty())
+        throw UsageError(refusal);
+}
+
 int view(ViewArgs &args) {
     viewer::ViewOptions o = args.options;
+    checkBind(o);
     o.rig_file = args.rig.file;
-    for (const auto &s : args.rig.overrides) o.overrides.push_back(Override::parse(s));
     o.max_frames = args.frames;
     PluginHost host;
     host.scan();
-    const viewer::ViewSummary s = viewer::runView(o, host, [](const std::string &url) {
-        std::cout << "binocle view: open " << url << "\n" << std::flush;
-    });
+    viewer::ViewSummary s;
+    try {
+        for (const auto &text : args.rig.overrides) o.overrides.push_back(Override::parse(text));
+        // The rig with the command line's --set is loaded before the page opens: a bad
+        // --set escapes from there only, never from the page's own commands.
+        s = viewer::runView(o, host, [](const std::string &url) {
+            std::cout << "binocle view: open " << url << "\n" << std::flush;
+        });
+    } catch (const OverrideError &e) {
+        throw UsageError(e.what()); // a bad --set is a bad value on the command line: exit 2, as in run
+    }
     const nlohmann::ordered_json j = {{"frames", s.frames},
                                       {"frames_sent", s.frames_sent},
                                       {"encode_ms_per_frame", s.frames_sent > 0 ? 1000 * s.encode_seconds / s.frames_sent : 0.0},

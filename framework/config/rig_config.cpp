@@ -344,6 +344,8 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
         fs::path p = c.Scalar();
         if (p.is_relative()) p = fs::path(ctx.base_dir) / p;
         if (!fs::exists(p)) ctx.fail(c, "calibration", "file '" + p.string() + "' does not exist");
+        if (std::error_code ec; !fs::is_regular_file(p, ec))
+            ctx.fail(c, "calibration", "'" + p.string() + "' is not a file (expected an OpenCV FileStorage YAML calibration)");
         rig.calibration_file = p.lexically_normal().string();
     }
     if (YAML::Node o = root["outputs"]; o.IsDefined() && !o.IsNull()) {
@@ -380,14 +382,38 @@ RigConfig rigFromTree(YAML::Node root, const std::string &file, const std::vecto
     return build(root, ctx, host);
 }
 
+// How messages name an override: "--set key=value" for one from the command line, else
+// its text, which says where it comes from ("test 3: source.range_mm=6000").
+std::string labelOf(const Override &o) { return o.text == o.path + "=" + o.value ? "--set " + o.text : o.text; }
+
+// A copy of `n` whose nodes carry no position: a value parsed from an override's text has
+// marks that count from the start of that text, and a message about it would otherwise
+// point at line 1 of the rig file, which never says it.
+YAML::Node unmarked(const YAML::Node &n) {
+    YAML::Node out;
+    if (n.IsScalar()) {
+        out = YAML::Node(n.Scalar());
+    } else if (n.IsSequence()) {
+        out = YAML::Node(YAML::NodeType::Sequence);
+        for (const auto &e : n) out.push_back(unmarked(e));
+    } else if (n.IsMap()) {
+        out = YAML::Node(YAML::NodeType::Map);
+        for (const auto &kv : n) out.force_insert(unmarked(kv.first), unmarked(kv.second));
+    } else {
+        out = YAML::Node(YAML::NodeType::Null);
+    }
+    out.SetTag(n.Tag());
+    return out;
+}
+
 } // namespace
 
 void applyOverride(YAML::Node &root, const Override &o) {
     const auto parts = splitPath(o.path);
-    if (parts.empty()) throw OverrideError("--set " + o.text + ": empty key");
+    if (parts.empty()) throw OverrideError(labelOf(o) + ": empty key");
     YAML::Node value;
     try {
-        value = input::parseYaml(o.value, "--set " + o.text);
+        value = unmarked(input::parseYaml(o.value, labelOf(o)));
     } catch (const input::YamlError &e) {
         throw OverrideError(e.what());
     }
@@ -396,7 +422,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
         int64_t i = 0;
         const int64_t last = static_cast<int64_t>(list.size()) - 1;
         if (!input::parseInteger(part, i, nullptr, 0, last))
-            throw OverrideError("--set " + o.text + ": '" + input::printable(part) + "' is not an index of the list (" +
+            throw OverrideError(labelOf(o) + ": '" + input::printable(part) + "' is not an index of the list (" +
                         (last < 0 ? std::string("the list is empty") : "0.." + std::to_string(last)) + ")");
         return static_cast<size_t>(i);
     };
@@ -414,7 +440,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
                 next = cur[parts[i]];
             }
         } else {
-            throw OverrideError("--set " + o.text + ": '" + parts[i] + "' leads into a scalar value");
+            throw OverrideError(labelOf(o) + ": '" + parts[i] + "' leads into a scalar value");
         }
         chain.push_back(next);
     }
@@ -422,7 +448,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
     if (last.IsSequence()) {
         last[index(last, parts.back())] = value;
     } else if (last.IsScalar()) {
-        throw OverrideError("--set " + o.text + ": the parent of '" + parts.back() + "' is a scalar value");
+        throw OverrideError(labelOf(o) + ": the parent of '" + parts.back() + "' is a scalar value");
     } else {
         last[parts.back()] = value;
     }

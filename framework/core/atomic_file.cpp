@@ -60,11 +60,14 @@ int createTemporary(const std::string &path, std::string &tmp) {
 }
 
 void commit(const std::string &tmp, const std::string &path) {
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
+    // rename(2) itself, its errno read at once: std::filesystem::rename reported a file
+    // renamed over a folder as "Success" (libstdc++ checks the target first).
+    if (::rename(tmp.c_str(), path.c_str()) != 0) {
+        const int err = errno;
+        std::error_code ec;
         fs::remove(tmp, ec);
-        throw Error("cannot write " + path + ": rename failed: " + ec.message());
+        throw Error("cannot write " + path + ": rename failed: " + std::strerror(err) +
+                    (err == EISDIR || fs::is_directory(path, ec) ? " (it is a folder; expected a file name)" : ""));
     }
 }
 

@@ -5,6 +5,8 @@
 #include "core/atomic_file.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
+#include "input/numbers.hpp"
+#include "input/text.hpp"
 
 #include <cstring>
 #include <fstream>
@@ -159,7 +161,14 @@ Cloud readPly(const std::string &path) {
     size_t n = 0;
     bool color = false, ground = false;
     while (std::getline(header, line)) {
-        if (line.rfind("element vertex ", 0) == 0) n = std::stoull(line.substr(15));
+        if (line.rfind("element vertex ", 0) == 0) {
+            int64_t count = 0;
+            std::string why;
+            // The data must hold them: at most as many vertices as there are bytes.
+            if (!input::parseInteger(line.substr(15), count, &why, 0, static_cast<int64_t>(bytes.size())))
+                throw Error(path + ": PLY header: element vertex '" + input::printable(line.substr(15)) + "' is not valid: " + why);
+            n = static_cast<size_t>(count);
+        }
         if (line == "property uchar red") color = true;
         if (line.rfind("comment frame ground", 0) == 0) ground = true;
         if (line.rfind("format ", 0) == 0 && line != "format binary_little_endian 1.0")

@@ -61,6 +61,11 @@ struct Experiment {
     std::string name, description;
     std::string rig_file; // the base rig
     YAML::Node rig;       // the base rig's tree
+    // The base rig's text and the rig_set: paths and values laid over it: each test's rig
+    // is parsed anew from them, so that its nodes keep their lines (YAML::Clone would
+    // put every one at line 1, column 1).
+    std::string rig_text;
+    std::vector<std::pair<std::string, std::string>> rig_set;
     int64_t frames = 1;
     std::vector<double> lenses_mm;            // the focal lengths the rig has
     double baseline_min_mm = 0, baseline_max_mm = 0;
@@ -150,6 +155,10 @@ struct ExperimentResult {
 
 // "K/N" -> (K, N), 1 <= K <= N; throws binocle::Error naming the option and the value.
 std::pair<int, int> parseShard(const std::string &text);
+
+// The tests a run does: its shard's, and of those the ones `options.only` names. Throws
+// binocle::Error naming an id the experiment lacks, or when none is selected.
+std::vector<const ExperimentTest *> selectTests(const Experiment &e, const ExperimentOptions &options);
 
 // Joins the results.json of shards (or partial runs) of one experiment in `dirs` into
 // `out_dir`: the rows in the experiment's test order, the predictors' rho and the charts

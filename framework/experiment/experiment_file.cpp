@@ -5,6 +5,7 @@
 #include "experiment/test_rig.hpp"
 
 #include "config/rig_config.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "input/numbers.hpp"
 #include "input/text.hpp"
@@ -140,6 +141,29 @@ YAML::Node loadYaml(const std::string &file) {
     return root;
 }
 
+// The base rig is read (its plugins' settings, its figures) before each test's rig is
+// validated in full: its shape is checked first, so that a file that is not a rig (a
+// calibration, `source: sim`) is named with what was expected, not with yaml-cpp's words.
+void checkRigShape(const YAML::Node &rig, const std::string &file, const std::string &namedAt) {
+    const std::string expected = "expected a rig: a YAML map with source: {plugin: NAME, ...} and matcher: {plugin: NAME, ...}";
+    if (!rig.IsMap()) throw Error(namedAt + ": " + file + " is not a rig (" + expected + ")");
+    std::vector<std::string> keys;
+    for (const auto &kv : rig) keys.push_back(kv.first.IsScalar() ? input::printable(kv.first.Scalar(), 40) : "(not a text)");
+    for (const char *block : {"source", "matcher"}) {
+        const YAML::Node b = rig[block];
+        if (!b.IsDefined())
+            throw Error(namedAt + ": " + file + " has no '" + block + "' block: " + expected + " (its top-level keys: " +
+                        (keys.empty() ? "none" : join(keys)) + ")");
+        const std::string at = b.Mark().is_null() ? file : file + ":" + std::to_string(b.Mark().line + 1) + ":" +
+                                                               std::to_string(b.Mark().column + 1);
+        if (!b.IsMap() || !b["plugin"].IsDefined() || !b["plugin"].IsScalar())
+            throw Error(at + ": " + block + ": value " +
+                        (b.IsScalar() ? "'" + input::printable(b.Scalar(), 40) + "'" : b.IsSequence() ? "(a list)" : "(empty)") +
+                        " is not valid: expected a map with 'plugin: <name>' and the plugin's settings (e.g. " + block +
+                        ": {plugin: " + (std::string(block) == "source" ? "sim" : "bm") + "})");
+    }
+}
+
 // The experiment file's tree with the --set overrides applied (each naming a top key).
 YAML::Node readRoot(const Experiment &e, const std::string &file, const std::vector<std::string> &overrides) {
     if (!fs::exists(e.file)) throw Error("experiment file " + file + " does not exist");
@@ -150,7 +174,7 @@ YAML::Node readRoot(const Experiment &e, const std::string &file, const std::vec
         const std::string top = o.path.substr(0, o.path.find('.'));
         if (std::find(kTopKeys.begin(), kTopKeys.end(), top) == kTopKeys.end()) {
             const std::string hint = input::nearestWord(top, kTopKeys);
-            throw Error("--set " + text + ": the experiment has no key '" + top + "'" +
+            throw OverrideError("--set " + text + ": the experiment has no key '" + top + "'" +
                         (hint.empty() ? "" : "; did you mean '" + hint + "'?") + " (valid keys: " + join(kTopKeys) + ")");
         }
         applyOverride(root, o);
@@ -167,17 +191,23 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
     e.rig_file = rigPath.lexically_normal().string();
     if (!fs::exists(e.rig_file)) r.fail(root["rig"], "rig: file '" + e.rig_file + "' does not exist");
     e.rig = loadYaml(e.rig_file);
-    if (!e.rig.IsMap()) throw Error(e.rig_file + ": expected a YAML map with source, matcher, ... at the top level");
+    e.rig_text = readTextFile(e.rig_file);
+    checkRigShape(e.rig, e.rig_file, r.where(root["rig"]) + ": rig");
     // rig_set: a partial rig laid over the base rig for every test (variants of a whole
     // experiment: `--set rig_set.source.image_width=640`).
     if (YAML::Node rs = root["rig_set"]) {
         if (!rs.IsMap()) r.fail(rs, "rig_set: expected a map, a partial rig laid over the base rig");
         std::function<void(const YAML::Node &, const std::string &)> lay = [&](const YAML::Node &n, const std::string &path) {
             if (n.IsMap()) {
-                for (const auto &kv : n) lay(kv.second, path + (path.empty() ? "" : ".") + kv.first.as<std::string>());
+                for (const auto &kv : n) lay(kv.second, path + (path.empty() ? "" : ".") + r.text(kv.first, "rig_set (a rig path)"));
                 return;
             }
-            applyOverride(e.rig, Override{path, yamlText(n), "rig_set: " + path});
+            try {
+                applyOverride(e.rig, Override{path, yamlText(n), "rig_set: " + path});
+                e.rig_set.emplace_back(path, yamlText(n));
+            } catch (const OverrideError &x) { // a mistake of the file (or of its --set rig_set...), named there
+                r.fail(n, std::string(x.what()) + " (laid over the base rig " + e.rig_file + ")");
+            }
         };
         lay(rs, "");
     }
@@ -206,7 +236,8 @@ void readHead(Experiment &e, const YAML::Node &root, const Reader &r, const Plug
     }
 
     if (root["image_height_px"]) e.head.image_height_px = static_cast<int>(r.integer(root["image_height_px"], "image_height_px", 1, kMaxWidth));
-    else if (e.rig["source"] && e.rig["source"]["image_height"]) e.head.image_height_px = e.rig["source"]["image_height"].as<int>();
+    else if (const YAML::Node s = e.rig["source"]; s.IsMap() && s["image_height"]) // as the rig states it, else unknown
+        e.head.image_height_px = static_cast<int>(Reader{e.rig_file}.integer(s["image_height"], "source.image_height", 1, kMaxWidth));
     if (YAML::Node d = root["disparity_search_px"]) {
         auto v = r.numbers(d, "disparity_search_px");
         if (v.size() != 2 || !(v[1] >= 1)) r.fail(d, "disparity_search_px: expected [min_disparity, num_disparities] of the matcher, e.g. [0, 64]");
@@ -239,11 +270,11 @@ void readRepeats(Experiment &e, const YAML::Node &root, const Reader &r) {
             e.seeds.push_back(seed);
         }
     }
-    if (root["seed_path"]) e.seed_path = root["seed_path"].as<std::string>();
+    if (root["seed_path"]) e.seed_path = r.text(root["seed_path"], "seed_path");
     if (YAML::Node j = root["jitter"]) {
         if (!j.IsMap()) r.fail(j, "jitter: expected a map rig path -> half width (e.g. source.range_mm: 50)");
         for (const auto &kv : j) {
-            const std::string path = kv.first.as<std::string>();
+            const std::string path = r.text(kv.first, "jitter (a rig path)");
             const double w = r.number(kv.second, "jitter." + path);
             if (w < 0) r.fail(kv.second, "jitter." + path + " = " + num(w) + ": expected a half width >= 0");
             e.jitter.emplace_back(path, w);
@@ -254,7 +285,7 @@ void readRepeats(Experiment &e, const YAML::Node &root, const Reader &r) {
 // Calibration per configuration: exact, or from board pairs.
 void readCalibration(Experiment &e, const YAML::Node &root, const Reader &r) {
     if (YAML::Node c = root["calibration"]) {
-        e.calibration = c.as<std::string>();
+        e.calibration = r.text(c, "calibration");
         if (e.calibration != "exact" && e.calibration != "board")
             r.fail(c, "calibration: '" + e.calibration + "': expected exact (the source's own) or board (calibrated per test)");
     }
@@ -264,7 +295,7 @@ void readCalibration(Experiment &e, const YAML::Node &root, const Reader &r) {
         auto &spec = e.board_calibration;
         if (b["pairs"]) spec.pairs = static_cast<int>(wholeNumber(r, b["pairs"], "board_calibration.pairs", 4, 1000));
         if (b["max_frames"]) spec.max_frames = static_cast<int>(wholeNumber(r, b["max_frames"], "board_calibration.max_frames", 1, 100000));
-        const std::string board = b["board"] ? b["board"].as<std::string>() : "9x6";
+        const std::string board = b["board"] ? r.text(b["board"], "board_calibration.board") : "9x6";
         const double square = b["square_mm"] ? r.number(b["square_mm"], "board_calibration.square_mm") : 25.0;
         try {
             spec.board = BoardSpec::parse(board, square);
@@ -273,7 +304,7 @@ void readCalibration(Experiment &e, const YAML::Node &root, const Reader &r) {
         }
         if (YAML::Node cap = b["capture"]) {
             if (!cap.IsMap()) r.fail(cap, "board_calibration.capture: expected a map of rig paths to values");
-            for (const auto &kv : cap) spec.capture.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+            for (const auto &kv : cap) spec.capture.emplace_back(r.text(kv.first, "board_calibration.capture (a rig path)"), yamlText(kv.second));
         }
     }
     if (e.calibration == "board" && e.board_calibration.capture.empty())
@@ -285,17 +316,12 @@ void readCalibration(Experiment &e, const YAML::Node &root, const Reader &r) {
 void readLensTable(Experiment &e, const YAML::Node &root, const Reader &r) {
     YAML::Node lt = root["lens_table"];
     if (!lt) return;
-    fs::path lp = lt.as<std::string>();
+    fs::path lp = r.text(lt, "lens_table");
     if (lp.is_relative()) lp = fs::path(e.file).parent_path() / lp;
     e.lens_table_file = lp.lexically_normal().string();
     if (!fs::exists(e.lens_table_file)) r.fail(lt, "lens_table: file '" + e.lens_table_file + "' does not exist");
-    YAML::Node table;
-    try {
-        table = YAML::LoadFile(e.lens_table_file);
-    } catch (const YAML::ParserException &x) {
-        throw Error(e.lens_table_file + ":" + std::to_string(x.mark.line + 1) + ": YAML syntax error: " + x.msg);
-    }
-    checkExpandedSize(table, e.lens_table_file);
+    // The one YAML loader: size bound, duplicate keys and syntax errors with line and column.
+    const YAML::Node table = loadYaml(e.lens_table_file);
     Reader lr{e.lens_table_file};
     if (!table.IsMap() || !table["lenses"] || !table["lenses"].IsSequence())
         throw Error(e.lens_table_file + ": expected a map with lenses: [{focal_length_mm, set: {rig path: value}}]");
@@ -309,7 +335,7 @@ void readLensTable(Experiment &e, const YAML::Node &root, const Reader &r) {
         if (lensFor(e, l.focal_length_mm)) lr.fail(ln, "lenses: focal length " + num(l.focal_length_mm) + " mm listed twice");
         if (YAML::Node st = ln["set"]) {
             if (!st.IsMap()) lr.fail(st, "lenses.set: expected a map of rig paths to values");
-            for (const auto &kv : st) l.set.emplace_back(kv.first.as<std::string>(), yamlText(kv.second));
+            for (const auto &kv : st) l.set.emplace_back(lr.text(kv.first, "lenses.set (a rig path)"), yamlText(kv.second));
         }
         e.lens_table.push_back(std::move(l));
     }
@@ -356,14 +382,19 @@ struct Defaults {
     std::set<std::string> given;
 };
 
-Defaults readDefaults(Experiment &e, const YAML::Node &root, const Reader &r) {
+Defaults readDefaults(Experiment &e, const YAML::Node &root, const Reader &r, const PluginHost &host) {
     Defaults out;
     for (const auto &var : kVariables) {
         const auto &paths = e.bind[var];
         if (paths.empty()) continue;
+        // As the rig states it, else the default of the plugin's setting: never 0 for a
+        // value nobody gave (a sim source refuses camera_height_mm 0, and the message would
+        // point at a rig that never says it).
         if (const auto v = rigNumber(e.rig, paths.front())) {
             *field(out.geometry, var) = *v;
             out.given.insert(var);
+        } else if (const auto d = settingDefault(e.rig, paths.front(), host)) {
+            *field(out.geometry, var) = *d;
         }
     }
     if (YAML::Node d = root["defaults"]) {
@@ -407,7 +438,8 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
     if (YAML::Node pp = tn["paper"]) {
         if (!pp.IsMap()) r.fail(pp, "test " + t.id + ": paper: expected a map figure -> value the paper reported");
         for (const auto &kv : pp)
-            t.paper.emplace_back(kv.first.as<std::string>(), r.number(kv.second, "test " + t.id + ": paper." + kv.first.as<std::string>()));
+            t.paper.emplace_back(r.text(kv.first, "test " + t.id + ": paper"),
+                                 r.number(kv.second, "test " + t.id + ": paper." + Reader::key(kv.first)));
     }
     if (!e.seeds.empty() && static_cast<int>(e.seeds.size()) < e.repeatsOf(t))
         r.fail(root["seeds"], "seeds: " + std::to_string(e.seeds.size()) + " seeds for " + std::to_string(e.repeatsOf(t)) +
@@ -426,7 +458,7 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
 }
 
 void readTests(Experiment &e, const YAML::Node &root, const Reader &r, const PluginHost &host) {
-    const Defaults defaults = readDefaults(e, root, r);
+    const Defaults defaults = readDefaults(e, root, r, host);
     YAML::Node tests = root["tests"];
     if (!tests || !tests.IsSequence() || tests.size() == 0) throw Error(e.file + ": missing key 'tests' (a list of tests)");
     std::set<std::string> ids;
@@ -463,9 +495,7 @@ void readCharts(Experiment &e, const YAML::Node &root, const Reader &r) {
     }
 }
 
-} // namespace
-
-Experiment loadExperiment(const std::string &file, const PluginHost &host, const std::vector<std::string> &overrides) {
+Experiment loadWith(const std::string &file, const PluginHost &host, const std::vector<std::string> &overrides) {
     std::error_code ec;
     Experiment e;
     e.file = fs::absolute(file, ec).lexically_normal().string();
@@ -486,6 +516,30 @@ Experiment loadExperiment(const std::string &file, const PluginHost &host, const
     readBind(e, root, r, host);
     readTests(e, root, r, host);
     readCharts(e, root, r);
+    return e;
+}
+
+} // namespace
+
+Experiment loadExperiment(const std::string &file, const PluginHost &host, const std::vector<std::string> &overrides) {
+    Experiment e;
+    try {
+        e = loadWith(file, host, overrides);
+    } catch (const OverrideError &) {
+        throw;
+    } catch (const Error &x) {
+        if (overrides.empty()) throw;
+        // Valid as written, refused with the --set values: the mistake is on the command
+        // line (exit status 2), whatever part of the file the message names.
+        try {
+            loadWith(file, host, {});
+        } catch (const Error &) {
+            throw x;
+        }
+        std::string given;
+        for (const auto &o : overrides) given += " --set " + o;
+        throw OverrideError(std::string(x.what()) + " (the file is valid without" + given + ")");
+    }
     warnUnbound(e);
     return e;
 }
@@ -499,6 +553,8 @@ Experiment makeExperiment(const std::string &name, const std::string &rig_file, 
     e.rig_file = fs::absolute(rig_file, ec).lexically_normal().string();
     if (!fs::exists(e.rig_file)) throw Error("rig file " + rig_file + " does not exist");
     e.rig = loadYaml(e.rig_file);
+    e.rig_text = readTextFile(e.rig_file);
+    checkRigShape(e.rig, e.rig_file, "--rig");
     e.bind = defaultBind(e.rig, host);
     for (size_t i = 0; i < tests.size(); ++i) {
         ExperimentTest t;

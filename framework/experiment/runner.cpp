@@ -9,6 +9,7 @@
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
+#include "input/numbers.hpp"
 #include "input/text.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
@@ -213,21 +214,15 @@ Row runTest(const Experiment &e, const ExperimentTest &t, const PluginHost &host
 
 std::pair<int, int> parseShard(const std::string &text) {
     const auto slash = text.find('/');
-    int k = 0, n = 0;
-    try {
-        size_t a = 0, b = 0;
-        if (slash == std::string::npos) throw std::invalid_argument(text);
-        k = std::stoi(text.substr(0, slash), &a);
-        n = std::stoi(text.substr(slash + 1), &b);
-        if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument(text);
-    } catch (const std::logic_error &) {
-        throw Error("--shard " + text + ": expected K/N, e.g. --shard 2/8 (the second of eight shares)");
-    }
-    if (n < 1 || k < 1 || k > n) throw Error("--shard " + text + ": expected 1 <= K <= N");
-    return {k, n};
+    int64_t k = 0, n = 0;
+    std::string why;
+    if (slash == std::string::npos || !input::parseInteger(text.substr(0, slash), k, &why, 1, 1000000) ||
+        !input::parseInteger(text.substr(slash + 1), n, &why, 1, 1000000))
+        throw Error("--shard " + input::printable(text) + ": expected K/N, e.g. --shard 2/8 (the second of eight shares)" +
+                    (why.empty() ? "" : "; " + why));
+    if (k > n) throw Error("--shard " + input::printable(text) + ": expected 1 <= K <= N");
+    return {static_cast<int>(k), static_cast<int>(n)};
 }
-
-namespace {
 
 // The tests this run does: its shard's, and of those the ones --tests names. An id that
 // is not in the experiment is an error (a typo would otherwise skip silently).
@@ -250,6 +245,8 @@ std::vector<const ExperimentTest *> selectTests(const Experiment &e, const Exper
         throw Error("experiment " + e.file + ": no test selected (ids: " + join(options.only) + ")");
     return selected;
 }
+
+namespace {
 
 // What --out already holds decides whether this run may write there: nothing of an
 // experiment's; this experiment's own results when every test runs again (they are

@@ -5,6 +5,8 @@
 
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
+#include "input/numbers.hpp"
+#include "input/yaml_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -51,7 +53,8 @@ namespace {
 // The settings table of the plugin a rig block names; empty when the block or the plugin
 // is missing (the rig's own validation says so, with its position).
 std::vector<binocle_param_desc> settingsOf(const YAML::Node &block, int32_t kind, const PluginHost &host) {
-    if (!block.IsMap() || !block["plugin"] || !block["plugin"].IsScalar()) return {};
+    // IsDefined first: IsMap() on a key a map lacks throws yaml-cpp's "invalid node".
+    if (!block.IsDefined() || !block.IsMap() || !block["plugin"] || !block["plugin"].IsScalar()) return {};
     const YAML::Node isolation = block["isolation"];
     const bool isolated = isolation && isolation.IsScalar() && isolation.Scalar() == "process";
     const PluginRecord *p = isolated ? host.describe(block["plugin"].Scalar(), kind) : host.lookup(block["plugin"].Scalar(), kind);
@@ -91,7 +94,7 @@ std::map<std::string, std::vector<std::string>> defaultBind(const YAML::Node &ri
 double sourceFigure(const YAML::Node &rig, const std::string &key, const PluginHost &host) {
     const YAML::Node source = rig["source"];
     double v = 0;
-    if (source.IsMap() && source[key] && YAML::convert<double>::decode(source[key], v)) return v;
+    if (source.IsDefined() && source.IsMap() && source[key] && YAML::convert<double>::decode(source[key], v)) return v;
     const auto *d = setting(settingsOf(source, BINOCLE_KIND_STEREO_SOURCE, host), key);
     if (d && d->default_value) {
         try {
@@ -100,6 +103,22 @@ double sourceFigure(const YAML::Node &rig, const std::string &key, const PluginH
         }
     }
     return 0;
+}
+
+std::optional<double> settingDefault(const YAML::Node &rig, const std::string &path, const PluginHost &host) {
+    const auto dot = path.rfind('.');
+    if (dot == std::string::npos) return std::nullopt;
+    const std::string top = path.substr(0, path.find('.'));
+    const int32_t kind = top == "source"       ? BINOCLE_KIND_STEREO_SOURCE
+                         : top == "matcher"    ? BINOCLE_KIND_MATCHER
+                         : top == "transforms" ? BINOCLE_KIND_CLOUD_TRANSFORM
+                         : top == "evaluators" ? BINOCLE_KIND_EVALUATOR
+                                               : -1;
+    if (kind < 0) return std::nullopt;
+    const auto *d = setting(settingsOf(nodeAt(rig, path.substr(0, dot)), kind, host), path.substr(dot + 1));
+    double v = 0;
+    if (d && d->default_value && input::parseReal(d->default_value, v)) return v;
+    return std::nullopt;
 }
 
 // A variable the tests set that goes nowhere in the rig is recorded in the results but
@@ -177,7 +196,13 @@ uint32_t Experiment::seedOf(int repeat) const {
 }
 
 YAML::Node rigForTest(const Experiment &e, const ExperimentTest &t, int repeat) {
-    YAML::Node rig = YAML::Clone(e.rig);
+    YAML::Node rig;
+    if (e.rig_text.empty()) { // an experiment built in code
+        rig = YAML::Clone(e.rig);
+    } else {
+        rig = input::parseYaml(e.rig_text, e.rig_file); // read once at load: it parsed then
+        for (const auto &[path, value] : e.rig_set) applyOverride(rig, Override{path, value, "rig_set: " + path});
+    }
     if (const Lens *lens = lensFor(e, t.geometry.focal_length_mm))
         for (const auto &[path, value] : lens->set)
             applyOverride(rig, Override{path, value, "lens table " + e.lens_table_file + ": f = " + num(lens->focal_length_mm) + ": " + path});

@@ -6,6 +6,7 @@
 #include "experiment/experiment.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 #include <yaml-cpp/yaml.h>
@@ -28,6 +29,9 @@ std::string yamlText(const YAML::Node &n); // flow style, one line: a value for 
 std::map<std::string, std::vector<std::string>> defaultBind(const YAML::Node &rig, const PluginHost &host);
 // A number the rig's source states for `key`, else its plugin's default; 0 when neither says.
 double sourceFigure(const YAML::Node &rig, const std::string &key, const PluginHost &host);
+// The default of the plugin setting a rig path names ("source.camera_height_mm",
+// "transforms.0.inclination_deg"), when that setting has a numeric default.
+std::optional<double> settingDefault(const YAML::Node &rig, const std::string &path, const PluginHost &host);
 // The lens of the lens table with this focal length, or nullptr.
 const Lens *lensFor(const Experiment &e, double focal_length_mm);
 // The node at a dotted rig path ("source.range_mm", "transforms.0.inclination_deg"), or

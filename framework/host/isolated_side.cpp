@@ -161,8 +161,10 @@ struct Served {
             m.data = nullptr;
             m.bytes = 0;
             void *p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+            const int mapErrno = errno; // before close() may change it
             ::close(fd);
-            if (p == MAP_FAILED) throw Error(std::string("helper: cannot map the shared memory: ") + std::strerror(errno));
+            if (p == MAP_FAILED)
+                throw Error("helper: cannot map " + std::to_string(bytes) + " bytes of shared memory: " + std::strerror(mapErrno));
             m.data = p;
             m.bytes = bytes;
         }

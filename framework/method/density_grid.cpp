@@ -29,6 +29,9 @@ void checkExtent(const Extent &e, const char *name) {
                                     number(e.max_mm) + "] mm: expected finite bounds with min < max");
 }
 
+// Cells of one view at most, checked before any grid is allocated (8000 x 8000).
+constexpr double kMaxViewCells = 64e6;
+
 int cellsAlong(const Extent &e, double cell) { return static_cast<int>(std::ceil(e.size() / cell - 1e-9)); }
 
 // u and v of a point in a view.
@@ -48,10 +51,22 @@ void GridSpec::validate() const {
     checkExtent(x, "X");
     checkExtent(y, "Y");
     checkExtent(z, "Z");
-    const double cells = static_cast<double>(cellsAlong(x, cell_mm)) * cellsAlong(y, cell_mm);
-    if (cells > 64e6)
-        throw std::invalid_argument("cell size " + number(cell_mm) + " mm over the grid's extent gives " + number(cells) +
-                                    " top-view cells: expected at most 64 million (a larger cell or a smaller extent)");
+    // Counted in doubles before any cast to int (4.3e11 mm / 100 mm overflows an int), for
+    // each of the three views: every axis has at least one cell, so each count bounds its
+    // axes too.
+    auto along = [&](const Extent &e) { return std::ceil(e.size() / cell_mm - 1e-9); };
+    const double nx = along(x), ny = along(y), nz = along(z);
+    const struct {
+        const char *view;
+        double cells;
+    } views[] = {{"top-view (X by Y)", nx * ny}, {"front-view (X by Z)", nx * nz}, {"side-view (Y by Z)", ny * nz}};
+    for (const auto &v : views)
+        if (!(v.cells <= kMaxViewCells))
+            throw std::invalid_argument("cell size " + number(cell_mm) + " mm over the grid's extent (X [" + number(x.min_mm) +
+                                        ", " + number(x.max_mm) + "], Y [" + number(y.min_mm) + ", " + number(y.max_mm) +
+                                        "], Z [" + number(z.min_mm) + ", " + number(z.max_mm) + "] mm) gives " +
+                                        number(v.cells) + " " + v.view + " cells: expected at most " +
+                                        number(kMaxViewCells) + " (a larger cell or a smaller extent)");
     if (density_threshold < 1)
         throw std::invalid_argument("density threshold " + std::to_string(density_threshold) +
                                     ": expected at least 1 point per cell");

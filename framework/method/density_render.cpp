@@ -2,17 +2,15 @@
 // Drawing density views: colour cells, axes in metres, titles, colour scale, overlays.
 #include "method/density_render.hpp"
 
+#include "core/atomic_file.hpp"
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <stdexcept>
-#include <system_error>
-#include <unistd.h>
 
 namespace binocle::method {
 
@@ -199,23 +197,9 @@ void writePngAtomic(const std::string &path, const cv::Mat &image) {
     std::vector<uint8_t> bytes;
     if (image.empty() || !cv::imencode(".png", image, bytes))
         throw std::runtime_error(path + ": cannot encode the picture as PNG");
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out.write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-        out.flush();
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            throw std::runtime_error(path + ": cannot write the file");
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw std::runtime_error(path + ": cannot write the file (rename failed)");
-    }
+    // The project's one crash-safe writer: a temporary with a random name, created
+    // O_EXCL | O_NOFOLLOW (a planted file or symlink is never written through), renamed.
+    writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
 } // namespace binocle::method

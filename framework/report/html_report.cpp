@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "input/text.hpp"
 #include "report/chart.hpp"
 #include "report/web_files.hpp"
 
@@ -379,6 +380,11 @@ std::vector<std::string> experimentFolders(const std::string &dir) {
     return out;
 }
 
+namespace {
+// The page of one experiment's results (below).
+std::string reportHtml(const fs::path &dir, const std::string &dirText, const fs::path &resultsPath, const OJson &results);
+} // namespace
+
 std::string writeExperimentReport(const std::string &dirText, const std::string &outputText) {
     const fs::path dir(dirText);
     const fs::path resultsPath = dir / "results.json";
@@ -386,6 +392,38 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
     const OJson results = OJson::parse(readFile(resultsPath), nullptr, false);
     if (results.is_discarded() || !results.is_object() || !results.contains("tests") || !results["tests"].is_array())
         throw Error("report: " + resultsPath.string() + " is not the results.json of an experiment (no \"tests\" list)");
+    // --output naming a folder (existing, or written with a final '/') gets report.html in
+    // it, as `calibrate --out` does: a file is never renamed over a folder.
+    std::error_code isDir;
+    const bool intoFolder = !outputText.empty() && (outputText.back() == '/' || fs::is_directory(outputText, isDir));
+    // Each row's test id names its folder test_<id>/, whose images are inlined: a file name,
+    // never a path out of DIR.
+    const auto &rows = results["tests"];
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const OJson &row = rows[i];
+        std::string why = "expected a text";
+        if (!row.is_object() || !row.contains("test") || !row["test"].is_string() ||
+            !input::isSafeName(row["test"].get<std::string>(), &why))
+            throw Error("report: " + resultsPath.string() + ": tests[" + std::to_string(i) + "].test " +
+                        (row.is_object() && row.contains("test") ? input::printable(row["test"].dump(), 60) : "(missing)") +
+                        " is not valid: " + why + " (the id of a test, which names its folder test_<id>/)");
+    }
+    const std::string output = outputText.empty() ? (dir / "report.html").string()
+                               : intoFolder       ? (fs::path(outputText) / "report.html").string()
+                                                  : outputText;
+    std::string html;
+    try {
+        html = reportHtml(dir, dirText, resultsPath, results);
+    } catch (const OJson::exception &e) { // a value of another type than binocle experiment writes
+        throw Error("report: " + resultsPath.string() + " is not the results.json of an experiment: " + e.what());
+    }
+    writeFileAtomic(output, html);
+    return output;
+}
+
+namespace {
+
+std::string reportHtml(const fs::path &dir, const std::string &dirText, const fs::path &resultsPath, const OJson &results) {
     const auto paper = paperValues(results);
     const std::string name = results.value("experiment", dir.filename().string());
     std::time_t written = std::time(nullptr);
@@ -422,9 +460,9 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
                                                             {"CHARTS", charts(dir)},
                                                             {"TESTS", tests},
                                                             {"PROVENANCE", provenance(results)}});
-    const std::string output = outputText.empty() ? (dir / "report.html").string() : outputText;
-    writeFileAtomic(output, html);
-    return output;
+    return html;
 }
+
+} // namespace
 
 } // namespace binocle::report

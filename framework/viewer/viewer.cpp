@@ -49,9 +49,8 @@ OJson errorReply(const std::string &op, const std::string &message) {
 // Refuses a non-loopback bind without --allow-remote; warns about what is allowed.
 void checkExposure(const ViewOptions &options) {
     const std::string risk = remoteBindRisk(options.address);
-    if (!risk.empty() && !options.allow_remote)
-        throw Error("view: " + risk + ". Add --allow-remote to serve it anyway, or leave --bind at 127.0.0.1 and reach it "
-                    "through an SSH tunnel (docs/security.md)");
+    if (const std::string refusal = remoteBindRefusal(options.address, options.allow_remote); !refusal.empty())
+        throw Error("view: " + refusal);
     if (!risk.empty()) spdlog::warn("view: {}", risk);
     if (::geteuid() == 0)
         spdlog::warn("view: running as root: whoever holds the page's token writes snapshots with root's rights; run binocle "

@@ -105,6 +105,13 @@ std::string remoteBindRisk(const std::string &address) {
            "write snapshots as this user";
 }
 
+std::string remoteBindRefusal(const std::string &address, bool allowRemote) {
+    const std::string risk = remoteBindRisk(address);
+    if (risk.empty() || allowRemote) return "";
+    return risk + ". Add --allow-remote to serve it anyway, or leave --bind at 127.0.0.1 and reach it through an SSH tunnel "
+                  "(docs/security.md)";
+}
+
 std::string safeFileName(std::string_view name, const std::string &fallback) {
     std::string out;
     for (const char c : name) {

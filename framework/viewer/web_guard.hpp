@@ -38,6 +38,8 @@ bool sameOrigin(std::string_view origin, std::string_view host);
 // page's token then travels in clear over the network, and the Host rule admits the
 // machine's addresses.
 std::string remoteBindRisk(const std::string &address);
+// The refusal of a bind that needs --allow-remote and lacks it, or "".
+std::string remoteBindRefusal(const std::string &address, bool allowRemote);
 
 // A file name for Content-Disposition: letters, digits, '-', '_' and '.', others become
 // '_', no leading '.', at most 80 characters; `fallback` when nothing is left.

@@ -228,7 +228,7 @@ Plan planMiddlebury(const Settings &s, const sdk::Host &host) {
         const fs::path calib = scene / "calib.txt";
         if (fs::is_regular_file(calib)) {
             PinholePair pair = readMiddleburyCalib(calib, f.left, f.facts);
-            pair.addFacts(f);
+            pair.addFacts(f, calib);
             calibrations.emplace_back(calib, pair);
         } else if (s.calibration.empty()) {
             host.warning("replay: Middlebury scene " + inQuotes(scene) + " has no calib.txt; it brings no calibration");
@@ -330,7 +330,7 @@ Plan planKitti(const Settings &s, const sdk::Host &host) {
         auto it = byStem.find(name.substr(0, name.find('_')));
         if (it == byStem.end() && byStem.size() == 1) it = byStem.begin();
         if (it == byStem.end()) continue;
-        it->second.second.addFacts(f);
+        it->second.second.addFacts(f, it->second.first);
         used.push_back(it->second);
     }
     if (calibFiles.empty() && s.calibration.empty())
@@ -398,7 +398,10 @@ Plan planRecording(const Settings &s, const sdk::Host &host) {
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording " + inQuotes(folder) + " holds no complete frame");
 
     const fs::path calibration = folder / recording::kCalibrationFile;
-    if (fs::is_regular_file(calibration)) plan.calibration = readText(calibration, "calibration");
+    if (fs::is_regular_file(calibration)) {
+        plan.calibration = readText(calibration, "calibration");
+        plan.calibrationOrigin = calibration.string();
+    }
     else if (s.calibration.empty())
         host.warning("replay: recording " + inQuotes(folder) + " has no calibration.yml; it brings no calibration");
     return plan;
@@ -467,7 +470,17 @@ Plan makePlan(const Settings &s, const sdk::Host &host) {
         if (!readable)
             throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: calibration " + inQuotes(s.calibration) +
                                                           " is not an OpenCV FileStorage YAML calibration with M1 and T");
+        // The frames are triangulated with this baseline: the layout's own files (a
+        // recording's calibration.yml, each frame's calib.txt) must not say another one.
+        if (const auto b = calibrationBaselineMm(text)) {
+            if (!plan.calibrationOrigin.empty())
+                if (const auto own = calibrationBaselineMm(plan.calibration))
+                    checkBaselineAgrees(*own, plan.calibrationOrigin, *b, s.calibration);
+            for (const FrameFiles &f : plan.frames)
+                if (!f.calibrationFile.empty()) checkBaselineAgrees(f.baselineMm, f.calibrationFile.string(), *b, s.calibration);
+        }
         plan.calibration = text;
+        plan.calibrationOrigin = s.calibration;
     }
 
     const auto available = static_cast<int64_t>(plan.frames.size());

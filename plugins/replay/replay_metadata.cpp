@@ -203,4 +203,28 @@ namespace {
 
 } // namespace
 
+std::optional<double> calibrationBaselineMm(const std::string &yaml) {
+    try {
+        cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+        if (!fs.isOpened()) return std::nullopt;
+        const cv::FileNode b = fs["baseline_mm"];
+        if (!b.empty() && (b.isReal() || b.isInt())) return static_cast<double>(b);
+        cv::Mat T;
+        fs["T"] >> T;
+        if (T.total() == 3) return cv::norm(T);
+    } catch (const cv::Exception &) {
+    }
+    return std::nullopt;
+}
+
+void checkBaselineAgrees(double stated_mm, const std::string &stated_file, double calibration_mm,
+                         const std::string &calibration_file) {
+    if (std::abs(stated_mm - calibration_mm) <= kBaselineTolerance * std::max(std::abs(stated_mm), std::abs(calibration_mm)))
+        return;
+    refuse("calibration '" + input::printable(calibration_file, 200) + "' has a baseline of " +
+           number(calibration_mm) + " mm but '" + input::printable(stated_file, 200) + "' states " + number(stated_mm) +
+           " mm for the same images; expected one baseline (within " + number(kBaselineTolerance * 100) +
+           " %): fix the calibration, or leave `calibration` unset to use the files' own");
+}
+
 } // namespace binocle::replay

@@ -37,4 +37,15 @@ struct KittiCalib {
 std::optional<KittiCalib> parseKittiCalib(const std::string &text, const std::string &origin, int leftIndex,
                                           int rightIndex);
 
+// The baseline (mm) an OpenCV FileStorage calibration states: its baseline_mm, else the
+// length of its T; nullopt when it states neither or is not readable.
+std::optional<double> calibrationBaselineMm(const std::string &yaml);
+
+// Refuses (sdk::Error, BINOCLE_ERR_INVALID_ARGUMENT, naming both files and both values) a
+// baseline that a layout's own file states and that differs from the calibration's by more
+// than kBaselineTolerance (relative).
+inline constexpr double kBaselineTolerance = 1e-3;
+void checkBaselineAgrees(double stated_mm, const std::string &stated_file, double calibration_mm,
+                         const std::string &calibration_file);
+
 } // namespace binocle::replay

@@ -29,12 +29,17 @@ struct FrameFiles {
     // Layout-specific facts for the frame's metadata ("ndisp", "recorded_sequence" ...).
     std::vector<std::pair<std::string, std::string>> facts;
     int64_t bagPair = -1; // mcap: the index of the pair in Plan::bag
+    // The calibration file of the frame's own metadata (Middlebury calib.txt, KITTI) and
+    // the baseline it states; empty and 0 when the layout has none for this frame.
+    std::filesystem::path calibrationFile;
+    double baselineMm = 0;
 };
 
 struct Plan {
     std::string layout;
     std::vector<FrameFiles> frames;
     std::string calibration; // FileStorage YAML text; empty when unknown
+    std::string calibrationOrigin; // the file it was read from (a recording's calibration.yml); empty otherwise
     // Recording: the last frame may have been cut short; if it cannot be decoded the
     // stream ends before it, with a warning, instead of failing.
     bool lenientLastFrame = false;
@@ -72,7 +77,10 @@ struct PinholePair {
         return fs.releaseAndGetString();
     }
 
-    void addFacts(FrameFiles &frame) const {
+    // The frame's focal length and baseline facts, and the file that states them.
+    void addFacts(FrameFiles &frame, const std::filesystem::path &file) const {
+        frame.calibrationFile = file;
+        frame.baselineMm = baselineMm;
         std::ostringstream f, b;
         f.precision(10);
         b.precision(10);

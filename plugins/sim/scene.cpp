@@ -182,7 +182,8 @@ public:
             for (size_t i = 0; i < objects.size(); ++i) object(objects[i], "objects[" + std::to_string(i) + "]");
         }
         if (const YAML::Node main = root["main_object"]) {
-            const std::string name = main.as<std::string>();
+            if (!main.IsScalar()) r_.fail(main, "main_object: expected the name of one of the objects, not a map or a list");
+            const std::string name = main.Scalar();
             scene_.mainObject = scene_.findObject(name);
             if (scene_.mainObject < 0) r_.fail(main, "main_object: no object named '" + name + "'");
         } else if (!scene_.objects.empty()) {
@@ -198,7 +199,7 @@ private:
         r_.onlyKeys(n, what, {"type", "color", "colors", "square_mm", "scale_mm", "octaves", "roughness", "contrast",
                               "sharpness", "stretch", "seed", "file", "size_mm"});
         if (!n["type"]) r_.fail(n, what + ": key 'type' is required (chessboard, noise, solid, image, or a preset)");
-        const std::string type = n["type"].as<std::string>();
+        const std::string type = r_.string(n, "type", "", what);
         Texture t;
         if (type == "chessboard") {
             t.kind = TextureKind::Chessboard;

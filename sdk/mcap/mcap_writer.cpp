@@ -43,8 +43,9 @@ struct Writer::Impl {
         while (n > 0) {
             const ssize_t w = ::write(fd, p, n);
             if (w < 0 && errno == EINTR) continue;
-            if (w <= 0)
-                throw Error(where() + ": cannot write at offset " + std::to_string(offset) + ": " + std::strerror(errno),
+            if (w <= 0) // write() returning 0 sets no errno
+                throw Error(where() + ": cannot write at offset " + std::to_string(offset) + ": " +
+                                (w < 0 ? std::strerror(errno) : "no byte written (is the disk full?)"),
                             static_cast<int64_t>(offset));
             p += w;
             n -= static_cast<size_t>(w);
@@ -231,9 +232,11 @@ Writer::Writer(const std::string &path, WriterOptions options) : impl_(std::make
     impl_->options = std::move(options);
     // O_EXCL: an existing file (or a planted symlink) is never written through.
     impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (impl_->fd < 0)
-        throw Error("mcap: cannot create " + path + ": " + std::strerror(errno) +
-                    (errno == EEXIST ? " (an existing file is never overwritten)" : ""));
+    if (impl_->fd < 0) {
+        const int err = errno; // read once: building the message may change it
+        throw Error("mcap: cannot create " + path + ": " + std::strerror(err) +
+                    (err == EEXIST ? " (an existing file is never overwritten)" : ""));
+    }
     Bytes head;
     head.raw(kMagic, sizeof kMagic);
     const size_t h = head.begin(Opcode::Header);

@@ -95,6 +95,7 @@ void generate(const std::string &line, const Placeholders &ph) {
     if (w[0] == "png") {
         ASSERT_EQ(w.size(), 4u) << line;
         cv::Mat m(std::stoi(w[3]), std::stoi(w[2]), CV_8UC1, cv::Scalar(128));
+        fs::create_directories(fs::path(w[1]).parent_path()); // left/ of a recording
         ASSERT_TRUE(cv::imwrite(w[1], m)) << line;
     } else if (w[0] == "truncate") {
         ASSERT_EQ(w.size(), 4u) << line;

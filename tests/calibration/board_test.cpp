@@ -44,7 +44,12 @@ TEST(Board, MalformedBoardsAreRefusedWithTheValue) {
     EXPECT_NE(errorOf([] { BoardSpec::parse("1x6", 25); }).find("at least 2x2"), std::string::npos);
     EXPECT_NE(errorOf([] { BoardSpec::parse("7x7", 25); }).find("no distinct orientation"), std::string::npos);
     EXPECT_NE(errorOf([] { BoardSpec::parse("9x6", 0); }).find("--square-mm"), std::string::npos);
-    EXPECT_NE(errorOf([] { BoardSpec::parse("9x6", -3); }).find("--square-mm"), std::string::npos);
+    EXPECT_NE(errorOf([] { BoardSpec::parse("9x6", -3); }).find("--square-mm -3: expected"), std::string::npos);
+    // The counts go through the one number reader: no leading zero, space or extra part.
+    EXPECT_NE(errorOf([] { BoardSpec::parse("09x6", 25); }).find("'09' is not valid: expected a decimal integer without leading zeros"),
+              std::string::npos);
+    EXPECT_NE(errorOf([] { BoardSpec::parse("9x6x2", 25); }).find("'6x2' is not valid"), std::string::npos);
+    EXPECT_NE(errorOf([] { BoardSpec::parse("9x1000", 25); }).find("'1000' is not valid"), std::string::npos);
 }
 
 TEST(Board, FindsTheOpenCvDocBoardWithSubPixelCorners) {

@@ -162,7 +162,7 @@ TEST(Design, RanksByFormFactorAndRefusesBadInput) {
     EXPECT_EQ(runCli("design").exit_code, 2); // usage: no target
     auto bad = runCli("design --range 6000 --lenses 8,x");
     EXPECT_EQ(bad.exit_code, 2);
-    EXPECT_NE(bad.output.find("'x' is not a number"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("--lenses 8,x: 'x' is not valid: expected"), std::string::npos) << bad.output;
 }
 
 TEST(Design, SimulateRanksByMeasuredEfficiency) {
@@ -252,9 +252,11 @@ TEST(ExperimentRepeats, BadSettingsAreRefusedBeforeAnythingRuns) {
     const std::string file = dir.str("rep.yaml");
     writeText(file, repeatText("", "  - {id: 1, range_mm: 6000, baseline_mm: 100, focal_length_mm: 8}\n"));
     auto r = runCli("experiment " + file + " --quiet --set repeat=3 --out " + dir.str("out"));
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2); // a bad value on the command line
     EXPECT_NE(r.output.find("--set repeat=3: the experiment has no key 'repeat'; did you mean 'repeats'?"), std::string::npos) << r.output;
     r = runCli("experiment " + file + " --quiet --set repeats=0 --out " + dir.str("out"));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("(the file is valid without --set repeats=0)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("repeats = 0: expected a whole number 1 .. 10000"), std::string::npos) << r.output;
     r = runCli("experiment " + file + " --quiet --set repeats=3 --set 'seeds=[1, 2]' --out " + dir.str("out"));
     EXPECT_NE(r.output.find("seeds: 2 seeds for 3 repeats of test 1"), std::string::npos) << r.output;
@@ -293,6 +295,7 @@ TEST(ExperimentShards, MergedShardsEqualTheUnshardedRun) {
     auto none = runCli("experiment merge " + dir.str("m3") + " " + dir.str("nothing"));
     EXPECT_NE(none.output.find("results.json cannot be read"), std::string::npos) << none.output;
     auto bad = runCli("experiment " + file + " --quiet --shard 3/2 --out " + dir.str("x"));
+    EXPECT_EQ(bad.exit_code, 2); // a bad value on the command line
     EXPECT_NE(bad.output.find("--shard 3/2: expected 1 <= K <= N"), std::string::npos) << bad.output;
     EXPECT_EQ(parseShard("2/8"), std::make_pair(2, 8));
     EXPECT_THROW(parseShard("2-8"), Error);
@@ -504,11 +507,11 @@ TEST(ExperimentInputs, MistakesAreRefusedBeforeAnythingRunsOrIsWritten) {
     const std::string file = dir.str("e.yaml"), out = dir.str("out");
     writeText(file, repeatText("", kFourTests));
     auto r = runCli("experiment " + file + " --quiet --tests 1,99 --out " + out);
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2); // a bad value on the command line
     EXPECT_NE(r.output.find("--tests 1, 99: experiment " + file + " has no test '99' (its tests: 1, 2, 3, 4)"), std::string::npos)
         << r.output;
     r = runCli("experiment " + file + " --quiet --set repeats=3 --set 'seeds=[5, 5, 5]' --out " + out);
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2); // the file is valid: the --set values are the mistake
     EXPECT_NE(r.output.find("seeds: 5 is listed twice: each repeat needs its own seed"), std::string::npos) << r.output;
     writeText(file, "name: ../../x\n" + repeatText("", kFourTests).substr(std::string("name: rep\n").size()));
     r = runCli("experiment " + file + " --quiet --check");

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 namespace binocle::test {
 namespace {
@@ -54,17 +56,27 @@ TEST(DensityGrid, BinsPointsIntoTheThreeViews) {
 }
 
 TEST(DensityGrid, RefusesABadSpec) {
+    const auto why = [](const GridSpec &spec) -> std::string {
+        try {
+            spec.validate();
+        } catch (const std::invalid_argument &e) {
+            return e.what();
+        }
+        return "(accepted)";
+    };
     GridSpec spec;
     spec.cell_mm = 0;
     EXPECT_THROW(spec.validate(), std::invalid_argument);
     spec.cell_mm = 100;
     spec.x = {10, -10};
-    try {
-        spec.validate();
-        FAIL();
-    } catch (const std::invalid_argument &e) {
-        EXPECT_NE(std::string(e.what()).find("X extent"), std::string::npos) << e.what();
-    }
+    EXPECT_NE(why(spec).find("X extent"), std::string::npos) << why(spec);
+    // 4.3e11 mm of X in 100 mm cells: 4.3e9 cells, past an int; counted before any cast.
+    spec.x = {-2.15e11, 2.15e11};
+    EXPECT_NE(why(spec).find("top-view (X by Y) cells: expected at most 6.4e+07"), std::string::npos) << why(spec);
+    // The front and side views count too (X by Z, Y by Z), not only the top view.
+    spec.x = {-6000, 6000};
+    spec.z = {0, 5e9};
+    EXPECT_NE(why(spec).find("front-view (X by Z) cells"), std::string::npos) << why(spec);
 }
 
 // The E1 panel seen from the top: three columns of cubes, 1 m apart, at the panel's range.
@@ -155,6 +167,18 @@ TEST(DensityRender, DrawsAReadablePictureAndWritesItWhole) {
     EXPECT_EQ(back.size(), img.size());
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
     EXPECT_THROW(writePngAtomic(dir.str("no/such/folder/x.png"), img), std::runtime_error);
+
+    // A symlink planted under the name the writer once used (PATH.tmp-<pid>) is never
+    // followed: its target stays untouched, and the picture still lands whole.
+    const std::string target = dir.str("target.txt");
+    writeText(target, "untouched");
+    const std::string planted = path + ".tmp-" + std::to_string(::getpid());
+    std::filesystem::create_symlink(target, planted);
+    writePngAtomic(path, img);
+    std::ifstream in(target);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "untouched");
+    EXPECT_TRUE(std::filesystem::is_symlink(planted));
+    EXPECT_EQ(cv::imread(path, cv::IMREAD_COLOR).size(), img.size());
 
     // The top view of an empty cloud is still a picture (axes, no cells).
     const cv::Mat empty = renderDensityView(binView(CloudView(), View::Top, spec));

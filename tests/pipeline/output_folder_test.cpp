@@ -123,6 +123,17 @@ TEST(AtomicFile, APlantedSymlinkUnderATemporaryNameIsNeverWrittenThrough) {
     EXPECT_TRUE(fs::is_symlink(dir.str(".tmp-" + std::to_string(::getpid()) + "-summary.json")));
 }
 
+TEST(AtomicFile, AFolderInTheWayIsNamedNotReportedAsSuccess) {
+    TempDir dir;
+    fs::create_directories(dir.str("taken"));
+    const std::string why = errorOf([&] { writeFileAtomic(dir.str("taken"), "x"); });
+    EXPECT_NE(why.find("cannot write " + dir.str("taken") + ": rename failed: Is a directory (it is a folder; expected a file name)"),
+              std::string::npos)
+        << why;
+    EXPECT_EQ(why.find("Success"), std::string::npos) << why;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1); // no temporary left
+}
+
 // ---- `binocle run` ------------------------------------------------------------------------------
 
 std::string simRig() { return std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/sim-videre.yaml"; }

@@ -49,6 +49,11 @@ TEST(Recording, RowsWrittenAreRowsRead) {
     ASSERT_EQ(other.rows.size(), 1u);
     EXPECT_EQ(other.rows[0].timestamp_left_ns, 1);
     EXPECT_EQ(other.rows[0].right, "b.png");
+    // A UTF-8 byte order mark (a spreadsheet's "CSV UTF-8") is not part of the first name.
+    const rec::Index bom = rec::parseIndex("\xEF\xBB\xBF" + std::string(rec::kIndexHeader) + "7,1,2,l.png,r.png\n", "bom.csv");
+    ASSERT_EQ(bom.rows.size(), 1u);
+    EXPECT_EQ(bom.rows[0].sequence, 7);
+    EXPECT_EQ(bom.rows[0].line, 2);
 }
 
 TEST(Recording, ALastRowCutShortIsDroppedAndSaidOthersAreRefused) {

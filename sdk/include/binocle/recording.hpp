@@ -100,7 +100,7 @@ inline std::vector<std::string> splitFields(std::string_view line) {
 } // namespace detail
 
 // Reads the text of frames.csv; `origin` names it in messages. The header may order
-// the columns as it likes (each exactly once); blank lines are skipped. Image paths must
+// the columns as it likes (each exactly once); blank lines and a UTF-8 byte order mark are skipped. Image paths must
 // stay inside the recording folder. Throws sdk::Error (BINOCLE_ERR_INVALID_ARGUMENT)
 // "<origin>:<line>: ..." for a bad header or a bad row other than the last.
 inline Index parseIndex(std::string_view text, const std::string &origin) {
@@ -110,6 +110,8 @@ inline Index parseIndex(std::string_view text, const std::string &origin) {
     };
     std::vector<Line> lines;
     int number = 0;
+    // A UTF-8 byte order mark (spreadsheets write one) is not part of the first column's name.
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     for (size_t start = 0; start < text.size();) {
         size_t end = text.find('\n', start);
         if (end == std::string_view::npos) end = text.size();
@@ -177,7 +179,10 @@ inline void appendDurably(int fd, std::string_view bytes, const std::string &pat
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
         if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) throw sdk::Error(BINOCLE_ERR_IO, "cannot write " + path + ": " + std::strerror(errno));
+        // write() returning 0 sets no errno: name what it means rather than a stale errno.
+        if (n <= 0)
+            throw sdk::Error(BINOCLE_ERR_IO, "cannot write " + path + ": " +
+                                                 (n < 0 ? std::strerror(errno) : "no byte written (is the disk full?)"));
         done += static_cast<size_t>(n);
     }
     if (::fsync(fd) != 0) throw sdk::Error(BINOCLE_ERR_IO, "cannot write " + path + ": fsync failed: " + std::strerror(errno));
