@@ -49,8 +49,10 @@ foreach(required include/binocle/abi.h include/binocle/abi/common.h include/bino
 endforeach()
 foreach(file IN LISTS installed)
   if(NOT file MATCHES "^include/binocle/(abi\\.h|abi/[a-z_]+\\.h|plugin\\.hpp|recording\\.hpp|text\\.hpp|mcap\\.hpp|ros2_messages\\.hpp|settings\\.hpp|numbers\\.hpp)$"
-     AND NOT file MATCHES "/cmake/Binocle/[A-Za-z_-]+\\.cmake$" AND NOT file MATCHES "^lib[^/]*/libbinocle_mcap\\.a$")
-    message(FATAL_ERROR "the SDK install holds ${file}: only the public headers and the CMake package belong to it")
+     AND NOT file MATCHES "/cmake/Binocle/[A-Za-z_-]+\\.cmake$" AND NOT file MATCHES "^lib[^/]*/libbinocle_mcap\\.a$"
+     # the Python bridge, copied per Python plugin by binocle_add_python_plugin
+     AND NOT file MATCHES "^lib[^/]*/binocle/python/binocle_python_bridge\\.so$")
+    message(FATAL_ERROR "the SDK install holds ${file}: only the public headers, the CMake package, the MCAP library and the Python bridge belong to it")
   endif()
 endforeach()
 
