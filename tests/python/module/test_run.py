@@ -118,3 +118,27 @@ def test_install_prefix_is_the_build_tree():
     prefix = binocle.install_prefix()
     assert os.path.isfile(os.path.join(prefix, "libexec", "binocle", "binocle-plugin-helper"))
     assert os.path.join(prefix, "lib", "binocle", "plugins") in binocle.plugin_search_path()
+
+
+def test_python_matcher_in_this_python_process(tmp_path):
+    # A matcher written in Python (examples/python_matcher), in process: the bridge joins
+    # this interpreter, and the pipeline's thread takes the GIL the loop released while
+    # waiting (a loop holding it would deadlock here).
+    if "numpy_sad" not in [p["name"] for p in binocle.plugins()]:
+        pytest.skip("the example Python matcher is not built (BINOCLE_PYTHON_PLUGINS=OFF)")
+    here = os.path.dirname(os.path.abspath(__file__))
+    repo = os.path.normpath(os.path.join(here, "..", "..", ".."))
+    data = "/usr/share/doc/opencv-doc/examples/data"
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(f"""
+source: {{plugin: replay, layout: glob, left: {data}/aloeL.jpg, right: {data}/aloeR.jpg,
+          ground_truth: {data}/aloeGT.png}}
+calibration: {repo}/configs/calibrations/opencv-aloe-ideal.yml
+matcher: {{plugin: numpy_sad, num_disparities: 64, window_px: 9}}
+evaluators: [{{plugin: disparity}}]
+""")
+    frames = list(binocle.Rig(str(rig)).run(frames=1))
+    assert len(frames) == 1
+    d = frames[0].disparity
+    assert d.shape == (1110, 1282) and d.dtype == np.float32
+    assert frames[0].figures["disparity.density_percent"] > 30
