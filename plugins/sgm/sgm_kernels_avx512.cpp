@@ -8,15 +8,7 @@
 #define CV_CPU_OPTIMIZATION_HAL_NAMESPACE hal_sgm_avx512
 #define CV_CPU_OPTIMIZATION_HAL_NAMESPACE_BEGIN namespace hal_sgm_avx512 {
 #define CV_CPU_OPTIMIZATION_HAL_NAMESPACE_END }
-#define CV_SSE3 1
-#define CV_SSSE3 1
-#define CV_SSE4_1 1
-#define CV_SSE4_2 1
-#define CV_POPCNT 1
-#define CV_AVX 1
-#define CV_FP16 1
-#define CV_FMA3 1
-#define CV_AVX2 1
+#include "sgm_simd_avx2_level.h"
 #define SGM_SIMD_VPOPCNT 1
 #define SGM_SIMD_NS avx512
 #include "sgm_kernels_simd.inl"
