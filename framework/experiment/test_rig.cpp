@@ -66,6 +66,8 @@ const binocle_param_desc *setting(const std::vector<binocle_param_desc> &table, 
         if (d.name && name == d.name) return &d;
     return nullptr;
 }
+// The answer points into the table: a temporary table would be gone before it is read.
+const binocle_param_desc *setting(std::vector<binocle_param_desc> &&table, const std::string &name) = delete;
 
 } // namespace
 
@@ -95,7 +97,8 @@ double sourceFigure(const YAML::Node &rig, const std::string &key, const PluginH
     const YAML::Node source = rig["source"];
     double v = 0;
     if (source.IsDefined() && source.IsMap() && source[key] && YAML::convert<double>::decode(source[key], v)) return v;
-    const auto *d = setting(settingsOf(source, BINOCLE_KIND_STEREO_SOURCE, host), key);
+    const auto table = settingsOf(source, BINOCLE_KIND_STEREO_SOURCE, host);
+    const auto *d = setting(table, key);
     if (d && d->default_value) {
         try {
             if (YAML::convert<double>::decode(YAML::Load(d->default_value), v)) return v;
@@ -115,7 +118,8 @@ std::optional<double> settingDefault(const YAML::Node &rig, const std::string &p
                          : top == "evaluators" ? BINOCLE_KIND_EVALUATOR
                                                : -1;
     if (kind < 0) return std::nullopt;
-    const auto *d = setting(settingsOf(nodeAt(rig, path.substr(0, dot)), kind, host), path.substr(dot + 1));
+    const auto table = settingsOf(nodeAt(rig, path.substr(0, dot)), kind, host);
+    const auto *d = setting(table, path.substr(dot + 1));
     double v = 0;
     if (d && d->default_value && input::parseReal(d->default_value, v)) return v;
     return std::nullopt;
