@@ -316,8 +316,8 @@ PYBIND11_MODULE(_binocle, m) {
         .def_property_readonly("name", [](const Rig &r) { return r.config().name; })
         .def_property_readonly("file", [](const Rig &r) { return r.config().file; }, "absolute path of the rig file")
         .def_property_readonly("yaml", [](const Rig &r) { return r.config().resolved_yaml; }, "the rig after the set overrides")
-        .def_property_readonly("source", [](const Rig &r) { return r.config().source.plugin; }, "the source plugin's name")
-        .def_property_readonly("matcher", [](const Rig &r) { return r.config().matcher.plugin; }, "the matcher plugin's name")
+        .def_property_readonly("source", [](const Rig &r) { return r.config().source().plugin; }, "the source plugin's name")
+        .def_property_readonly("matcher", [](const Rig &r) { return r.config().matcher().plugin; }, "the matcher plugin's name")
         .def("__repr__", [](const Rig &r) { return "<binocle.Rig '" + r.config().name + "' " + r.config().file + ">"; });
 
     m.def("experiment", &experiment, py::arg("file"), py::arg("set") = py::none(), py::arg("out") = py::none(),

@@ -144,9 +144,9 @@ struct SourcePairs {
 // Pairs from the rig's source: every frame, or (live) those where the board is still.
 void pairsFromSource(StereoCalibrator &calibrator, const RigConfig &rig, const SourcePairs &how, const CalibrationOptions &options,
                      const std::string &boardText) {
-    Source source(*rig.source.record, rig.source.params);
+    Source source(*rig.source().record, rig.source().params);
     spdlog::info("binocle calibrate: {} board, {} mm squares, pairs from source '{}'{}", boardText, options.board.square_mm,
-                 rig.source.plugin,
+                 rig.source().plugin,
                  how.live ? " (live: a pair is taken when the board has been still for " + std::to_string(how.stillFrames) + " frames)"
                           : "");
     source.start();
@@ -176,7 +176,7 @@ void pairsFromSource(StereoCalibrator &calibrator, const RigConfig &rig, const S
     }
     progress.finish();
     source.stop();
-    if (calibrator.pairs().empty()) throw Error("source '" + rig.source.plugin + "' delivered no pair to calibrate with");
+    if (calibrator.pairs().empty()) throw Error("source '" + rig.source().plugin + "' delivered no pair to calibrate with");
 }
 
 // Names the calibration after its configuration (what the rig states, else what was
@@ -240,7 +240,7 @@ int calibrate(const CalibrateArgs &args, const CLI::App &app) {
         host.emplace();
         // No scan: the rig opens only the plugins it names.
         rig = loadRig(args.rig, *host);
-        stated = statedGeometry(rig->source);
+        stated = statedGeometry(rig->source());
     } else if (!args.rig.overrides.empty()) {
         throw UsageError("--set changes a rig, but no rig file was given");
     }

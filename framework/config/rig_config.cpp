@@ -3,6 +3,7 @@
 #include "config/rig_config.hpp"
 
 #include "core/error.hpp"
+#include "host/plugin_kinds.hpp"
 #include "input/numbers.hpp"
 #include "input/text.hpp"
 #include "input/yaml_file.hpp"
@@ -18,6 +19,12 @@
 namespace fs = std::filesystem;
 
 namespace binocle {
+
+const std::vector<PluginBlock> &RigConfig::blocks(int32_t kind) const {
+    static const std::vector<PluginBlock> none;
+    const auto it = plugins.find(kind);
+    return it == plugins.end() ? none : it->second;
+}
 
 std::string Location::str() const {
     if (!override.empty()) return "command line --set " + override;
@@ -225,8 +232,13 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
     return values;
 }
 
-const std::vector<std::string> kTopKeys = {"name", "description", "source", "calibration", "matcher",
-                                           "transforms", "evaluators", "outputs", "runtime"};
+// The keys of a rig's top level: its own, and every plugin kind's rig key.
+std::vector<std::string> topKeys() {
+    std::vector<std::string> keys = {"name", "description"};
+    for (const PluginKind *k : pluginKinds()) keys.emplace_back(k->rigKey);
+    keys.insert(keys.end(), {"calibration", "outputs", "runtime"});
+    return keys;
+}
 // `outputs:`, described as settings are; the order is the one build() reads them in.
 const binocle_param_desc kOutputKeys[] = {
     sdk::Param::boolean("disparity_png", true), sdk::Param::boolean("disparity_color", true),
@@ -324,7 +336,7 @@ std::vector<PluginBlock> blockList(const YAML::Node &node, const std::string &wh
 
 RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &host) {
     if (!root.IsMap()) throw Error(ctx.file + ": expected a YAML map with source, matcher, ... at the top level");
-    if (auto unknown = input::findUnknownKey(root, kTopKeys))
+    if (auto unknown = input::findUnknownKey(root, topKeys()))
         ctx.raise(ctx.at(unknown->key, unknown->name), unknown->message);
     RigConfig rig;
     rig.file = ctx.file;
@@ -335,10 +347,13 @@ RigConfig build(const YAML::Node &root, const Context &ctx, const PluginHost &ho
     } else {
         rig.name = fs::path(ctx.file).stem().string();
     }
-    rig.source = block(root["source"], "source", BINOCLE_KIND_STEREO_SOURCE, host, ctx);
-    rig.matcher = block(root["matcher"], "matcher", BINOCLE_KIND_MATCHER, host, ctx);
-    rig.transforms = blockList(root["transforms"], "transforms", BINOCLE_KIND_CLOUD_TRANSFORM, host, ctx);
-    rig.evaluators = blockList(root["evaluators"], "evaluators", BINOCLE_KIND_EVALUATOR, host, ctx);
+    for (const PluginKind *k : pluginKinds()) {
+        const YAML::Node node = root[k->rigKey];
+        if (k->inRig == PluginKind::InRig::List)
+            rig.plugins[k->kind] = blockList(node, k->rigKey, k->kind, host, ctx);
+        else if (k->inRig == PluginKind::InRig::One || (node.IsDefined() && !node.IsNull()))
+            rig.plugins[k->kind] = {block(node, k->rigKey, k->kind, host, ctx)};
+    }
     if (YAML::Node c = root["calibration"]; c.IsDefined() && !c.IsNull()) {
         if (!c.IsScalar()) ctx.fail(c, "calibration", "expected the path of a calibration file (OpenCV FileStorage YAML)");
         fs::path p = c.Scalar();

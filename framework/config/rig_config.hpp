@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "host/plugin_host.hpp"
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,14 +58,22 @@ struct RigConfig {
     std::string file;     // absolute path of the YAML
     std::string base_dir; // its folder: relative paths resolve against it
     std::string name;
-    PluginBlock source;
+    // Every plugin block, by kind (BINOCLE_KIND_*), in the rig's order. Each kind's
+    // descriptor (host/plugin_kinds.hpp) says where a rig file holds its blocks (its rig
+    // key; one block, at most one, or a list): a new kind adds nothing here.
+    std::map<int32_t, std::vector<PluginBlock>> plugins;
     std::optional<std::string> calibration_file; // overrides the source's calibration
-    PluginBlock matcher;
-    std::vector<PluginBlock> transforms;
-    std::vector<PluginBlock> evaluators;
     OutputOptions outputs;
     RuntimeOptions runtime;
     std::string resolved_yaml; // the rig after --set overrides
+
+    // A kind's blocks; empty when the rig has none.
+    const std::vector<PluginBlock> &blocks(int32_t kind) const;
+    // The kinds every rig has (a rig is refused without a source and a matcher).
+    const PluginBlock &source() const { return blocks(BINOCLE_KIND_STEREO_SOURCE).at(0); }
+    const PluginBlock &matcher() const { return blocks(BINOCLE_KIND_MATCHER).at(0); }
+    const std::vector<PluginBlock> &transforms() const { return blocks(BINOCLE_KIND_CLOUD_TRANSFORM); }
+    const std::vector<PluginBlock> &evaluators() const { return blocks(BINOCLE_KIND_EVALUATOR); }
 };
 
 // A mistake in a value that came from the command line (--set): the command reports it

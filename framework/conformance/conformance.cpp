@@ -10,6 +10,7 @@
 #include "host/isolation.hpp"
 #include "host/plugin_host.hpp"
 #include "host/plugin_kinds.hpp"
+#include "input/text.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -21,13 +22,10 @@ namespace fs = std::filesystem;
 
 namespace binocle {
 
-// The families of cases, one per kind (cases_<kind>.cpp); a new kind adds its line here
-// and in families() below.
+// The families of cases, one per kind (cases_<kind>.cpp defines <kind>Cases); the list is
+// generated from those file names (framework/CMakeLists.txt), so a new kind edits no list.
 namespace conformance {
-void sourceCases(Battery &b);
-void matcherCases(Battery &b);
-void transformCases(Battery &b);
-void evaluatorCases(Battery &b);
+std::vector<std::pair<const char *, void (*)(Battery &)>> familiesByFile();
 } // namespace conformance
 
 int ConformanceReport::count(ConformanceCase::Status s) const {
@@ -52,28 +50,16 @@ using Clock = std::chrono::steady_clock;
 // Each kind's family of cases; a kind without one gets the load, table and settings cases.
 using Family = void (*)(conformance::Battery &);
 const std::map<int32_t, Family> &families() {
-    static const std::map<int32_t, Family> f = {{BINOCLE_KIND_STEREO_SOURCE, &conformance::sourceCases},
-                                                {BINOCLE_KIND_MATCHER, &conformance::matcherCases},
-                                                {BINOCLE_KIND_CLOUD_TRANSFORM, &conformance::transformCases},
-                                                {BINOCLE_KIND_EVALUATOR, &conformance::evaluatorCases}};
-    return f;
-}
-
-std::string xmlEscape(const std::string &s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        case '\'': out += "&apos;"; break;
-        default:
-            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
-            else out += c;
+    static const std::map<int32_t, Family> f = [] {
+        std::map<int32_t, Family> byKind;
+        for (const auto &[name, family] : conformance::familiesByFile()) {
+            const PluginKind *k = pluginKindNamed(name);
+            if (!k) throw Error(std::string("conformance: cases_") + name + ".cpp names no plugin kind of the host");
+            byKind[k->kind] = family;
         }
-    }
-    return out;
+        return byKind;
+    }();
+    return f;
 }
 
 // The plugin's file: FILE.so as given, or binocle_NAME.so in the search path.
@@ -217,19 +203,19 @@ std::string junitXml(const ConformanceReport &r) {
     os << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
     os << "<testsuites tests=\"" << r.cases.size() << "\" failures=\"" << r.count(Status::Failed) << "\" skipped=\""
        << r.count(Status::Skipped) << "\">\n";
-    os << "  <testsuite name=\"" << xmlEscape(classname) << "\" tests=\"" << r.cases.size() << "\" failures=\""
+    os << "  <testsuite name=\"" << input::xmlEscape(classname) << "\" tests=\"" << r.cases.size() << "\" failures=\""
        << r.count(Status::Failed) << "\" errors=\"0\" skipped=\"" << r.count(Status::Skipped) << "\" time=\"" << total << "\">\n";
-    os << "    <properties><property name=\"file\" value=\"" << xmlEscape(r.path) << "\"/></properties>\n";
+    os << "    <properties><property name=\"file\" value=\"" << input::xmlEscape(r.path) << "\"/></properties>\n";
     for (const auto &c : r.cases) {
-        os << "    <testcase classname=\"" << xmlEscape(classname) << "\" name=\"" << xmlEscape(c.name) << "\" time=\"" << c.seconds << "\"";
+        os << "    <testcase classname=\"" << input::xmlEscape(classname) << "\" name=\"" << input::xmlEscape(c.name) << "\" time=\"" << c.seconds << "\"";
         if (c.status == Status::Passed) {
             os << ">";
-            if (!c.message.empty()) os << "<system-out>" << xmlEscape(c.message) << "</system-out>";
+            if (!c.message.empty()) os << "<system-out>" << input::xmlEscape(c.message) << "</system-out>";
             os << "</testcase>\n";
         } else if (c.status == Status::Failed) {
-            os << "><failure message=\"" << xmlEscape(c.message) << "\"/></testcase>\n";
+            os << "><failure message=\"" << input::xmlEscape(c.message) << "\"/></testcase>\n";
         } else {
-            os << "><skipped message=\"" << xmlEscape(c.message) << "\"/></testcase>\n";
+            os << "><skipped message=\"" << input::xmlEscape(c.message) << "\"/></testcase>\n";
         }
     }
     os << "  </testsuite>\n</testsuites>\n";

@@ -42,14 +42,14 @@ BoardCalibrationOutcome calibrateConfiguration(const YAML::Node &testRig, const 
     for (const auto &[path, value] : spec.capture)
         applyOverride(captureRig, Override{path, value, "board_calibration.capture: " + path});
     const RigConfig rig = rigFromNode(captureRig, rigFile, host);
-    Source source(*rig.source.record, rig.source.params);
+    Source source(*rig.source().record, rig.source().params);
 
     BoardCalibrationOutcome out;
     out.file = calibrationFile;
     StereoCalibration truth;
     bool haveTruth = false;
     if (const std::string published = source.calibration(); !published.empty()) {
-        truth = StereoCalibration::fromYaml(published, "calibration published by source '" + rig.source.plugin + "'");
+        truth = StereoCalibration::fromYaml(published, "calibration published by source '" + rig.source().plugin + "'");
         haveTruth = true;
     }
 

@@ -194,7 +194,7 @@ void create(Served &s, Reader &r) {
 // One request: its reply's payload goes to `payload`.
 void answer(Served &s, const std::string &msg, int &received, Writer &payload) {
     Reader r(msg);
-    const RequestHead head = getHead(r);
+    const RequestHead head = get<RequestHead>(r);
     if (head.op == kDestroy) {
         s.instance.reset();
         return;

@@ -91,16 +91,6 @@ bool receiveMessage(int sock, std::string &msg, int *fd) {
 
 // ---- Requests -----------------------------------------------------------------------------------
 
-void putHead(Writer &w, const RequestHead &h) { w.put<uint32_t>(h.op).put<uint32_t>(h.region).put<uint64_t>(h.region_bytes); }
-
-RequestHead getHead(Reader &r) {
-    RequestHead h;
-    h.op = r.get<uint32_t>();
-    h.region = r.get<uint32_t>();
-    h.region_bytes = r.get<uint64_t>();
-    return h;
-}
-
 void putParams(Writer &w, const ParamValues &params) {
     w.put<int32_t>(params.size());
     for (int32_t i = 0; i < params.size(); ++i) {
@@ -140,46 +130,11 @@ std::pair<int32_t, ParamValues> getCreate(Reader &r) {
 
 // ---- Messages -----------------------------------------------------------------------------------
 
-std::string encode(const LogMessage &m) {
-    return Writer().put<uint32_t>(kLog).put<uint8_t>(m.origin).put<int32_t>(m.level).str(m.text).data();
-}
-std::string encode(const MetricMessage &m) {
-    return Writer().put<uint32_t>(kMetric).str(m.name).put<double>(m.value).str(m.unit).data();
-}
-std::string encode(const TextMessage &m) { return Writer().put<uint32_t>(kText).str(m.name).str(m.text).data(); }
-
-LogMessage getLog(Reader &r) {
-    LogMessage m;
-    m.origin = r.get<uint8_t>();
-    m.level = r.get<int32_t>();
-    m.text = r.str();
-    return m;
-}
-
-MetricMessage getMetric(Reader &r) {
-    MetricMessage m;
-    m.name = r.str();
-    m.value = r.get<double>();
-    m.unit = r.str();
-    return m;
-}
-
-TextMessage getText(Reader &r) {
-    TextMessage m;
-    m.name = r.str();
-    m.text = r.str();
-    return m;
-}
-
 std::string encodeReply(int32_t rc, const std::string &message, const std::string &payload) {
-    return Writer().put<uint32_t>(kReply).put<int32_t>(rc).str(message).raw(payload).data();
-}
-
-ReplyHead getReplyHead(Reader &r) {
-    ReplyHead h;
-    h.rc = r.get<int32_t>();
-    h.message = r.str();
-    return h;
+    Writer w;
+    w.put<uint32_t>(kReply);
+    put(w, ReplyHead{rc, message});
+    return w.raw(payload).data();
 }
 
 void putDescription(Writer &w, const binocle_plugin_header &h, const std::vector<binocle_param_desc> &params) {

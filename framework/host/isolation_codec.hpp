@@ -17,6 +17,7 @@
 #include <deque>
 #include <string>
 #include <utility>
+#include <type_traits>
 #include <vector>
 
 namespace binocle::wire {
@@ -43,6 +44,12 @@ public:
     Writer &raw(const std::string &bytes) {
         buf_ += bytes;
         return *this;
+    }
+    // One field of a message described by its fields (below): a number or a text.
+    template <class T>
+    Writer &field(const T &v) {
+        if constexpr (std::is_same_v<T, std::string>) return str(v);
+        else return put<T>(v);
     }
     const std::string &data() const { return buf_; }
 
@@ -73,6 +80,11 @@ public:
     std::pair<bool, std::string> cstr() {
         const bool present = get<uint8_t>() != 0;
         return {present, str()};
+    }
+    template <class T>
+    void field(T &v) {
+        if constexpr (std::is_same_v<T, std::string>) v = str();
+        else v = get<T>();
     }
     bool atEnd() const { return at_ == data_.size(); }
 
@@ -109,14 +121,28 @@ enum Op : uint32_t {
 // When the request carries a file descriptor, it is that region's (new) file.
 constexpr uint32_t kNoRegion = 0xffffffffu;
 
+// Messages of fixed fields are described once, by the list of their fields in wire order
+// (`fields`, for a const and a mutable message alike): put() and get() both walk that
+// list, so encoding and decoding cannot drift.
+template <class M>
+void put(Writer &w, const M &m) {
+    M::fields(m, [&](const auto &...f) { (w.field(f), ...); });
+}
+template <class M>
+M get(Reader &r) {
+    M m;
+    M::fields(m, [&](auto &...f) { (r.field(f), ...); });
+    return m;
+}
+
 // What every request starts with; the operation's own fields follow.
 struct RequestHead {
     uint32_t op = 0;
     uint32_t region = kNoRegion;
     uint64_t region_bytes = 0;
+    template <class M, class F>
+    static void fields(M &m, F &&f) { f(m.op, m.region, m.region_bytes); }
 };
-void putHead(Writer &w, const RequestHead &h);
-RequestHead getHead(Reader &r);
 
 // kCreate: the kind the host expects and the settings.
 void putCreate(Writer &w, int32_t kind, const ParamValues &params);
@@ -137,35 +163,47 @@ enum LogOrigin : uint8_t {
     kFromHelper = 2, // the helper process's own words (they name the plugin already)
 };
 
+// Each message: its type, then its fields; read with get<LogMessage>(r) etc. after the
+// type (kLog, kMetric, kText) was read.
 struct LogMessage {
+    static constexpr uint32_t type = kLog;
     uint8_t origin = kFromPlugin;
     int32_t level = 0;
     std::string text;
+    template <class M, class F>
+    static void fields(M &m, F &&f) { f(m.origin, m.level, m.text); }
 };
 struct MetricMessage {
+    static constexpr uint32_t type = kMetric;
     std::string name;
     double value = 0;
     std::string unit;
+    template <class M, class F>
+    static void fields(M &m, F &&f) { f(m.name, m.value, m.unit); }
 };
 struct TextMessage {
+    static constexpr uint32_t type = kText;
     std::string name, text;
+    template <class M, class F>
+    static void fields(M &m, F &&f) { f(m.name, m.text); }
 };
-std::string encode(const LogMessage &m);
-std::string encode(const MetricMessage &m);
-std::string encode(const TextMessage &m);
-// After the message type (kLog, kMetric, kText) was read.
-LogMessage getLog(Reader &r);
-MetricMessage getMetric(Reader &r);
-TextMessage getText(Reader &r);
+template <class M>
+std::string encode(const M &m) {
+    Writer w;
+    w.put<uint32_t>(M::type);
+    put(w, m);
+    return w.data();
+}
 
 // The end of a call: the result code, the plugin's message, then the call's own payload.
 std::string encodeReply(int32_t rc, const std::string &message, const std::string &payload);
+// After kReply was read, get<ReplyHead>(r) leaves the Reader at the payload.
 struct ReplyHead {
     int32_t rc = 0;
     std::string message;
+    template <class M, class F>
+    static void fields(M &m, F &&f) { f(m.rc, m.message); }
 };
-// After kReply was read; the Reader is left at the payload.
-ReplyHead getReplyHead(Reader &r);
 
 // kDescribe's reply: a plugin header and settings table, by value.
 void putDescription(Writer &w, const binocle_plugin_header &h, const std::vector<binocle_param_desc> &params);

@@ -215,7 +215,7 @@ PluginProxy::Reply PluginProxy::call(uint32_t op, const std::string &payload, Sh
         if (region->sentTo != generation_) fd = region->fd();
     }
     wire::Writer w;
-    wire::putHead(w, head);
+    wire::put(w, head);
     w.raw(payload);
     Reply r = exchange(who, w.data(), fd, timeout_ms < 0 ? options_.call_timeout_ms : timeout_ms,
                        limit ? limit : "call_timeout_ms");
@@ -250,7 +250,7 @@ PluginProxy::Reply PluginProxy::exchange(const std::string &who, const std::stri
             wire::Reader r(msg);
             const auto type = r.get<uint32_t>();
             if (type == wire::kReply) {
-                const wire::ReplyHead head = wire::getReplyHead(r);
+                const wire::ReplyHead head = wire::get<wire::ReplyHead>(r);
                 Reply reply;
                 reply.rc = head.rc;
                 reply.message = head.message;
@@ -282,15 +282,15 @@ PluginProxy::Reply PluginProxy::exchange(const std::string &who, const std::stri
 
 void PluginProxy::dispatch(uint32_t type, wire::Reader &r) {
     if (type == wire::kLog) {
-        const wire::LogMessage m = wire::getLog(r);
+        const wire::LogMessage m = wire::get<wire::LogMessage>(r);
         if (m.origin == wire::kFromHelper) spdlog::log(spdlogLevel(m.level), "{}", m.text);
         else if (host_ && host_->log) host_->log(host_->context, m.level, m.text.c_str());
         else logFromPlugin(record_.name, m.level, m.text);
     } else if (type == wire::kMetric) {
-        const wire::MetricMessage m = wire::getMetric(r);
+        const wire::MetricMessage m = wire::get<wire::MetricMessage>(r);
         if (host_ && host_->report_metric) host_->report_metric(host_->context, m.name.c_str(), m.value, m.unit.c_str());
     } else if (type == wire::kText) {
-        const wire::TextMessage m = wire::getText(r);
+        const wire::TextMessage m = wire::get<wire::TextMessage>(r);
         if (host_ && host_->report_text) host_->report_text(host_->context, m.name.c_str(), m.text.c_str());
     } else {
         throw Error("a message of unknown type " + std::to_string(type));

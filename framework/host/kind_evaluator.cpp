@@ -119,7 +119,7 @@ void Evaluator::finish() { impl_->finish(); }
 const PluginKind &evaluatorKind() {
     using T = binocle_evaluator_api;
     static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_EVALUATOR, "evaluator", "evaluators", true);
+        PluginKind k = tableKind<T>(BINOCLE_KIND_EVALUATOR, "evaluator", "evaluators", PluginKind::InRig::List);
         k.versions = {{1, BINOCLE_END_OF(T, finish), "finish"}};
         k.entries.push_back({"evaluate", offsetof(T, evaluate), true, kEvaluate});
         k.entries.push_back({"finish", offsetof(T, finish), false, kFinish});

@@ -163,7 +163,7 @@ std::pair<int32_t, int32_t> Matcher::disparityRange() { return impl_->disparityR
 const PluginKind &matcherKind() {
     using T = binocle_matcher_api;
     static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_MATCHER, "matcher", "matcher", false);
+        PluginKind k = tableKind<T>(BINOCLE_KIND_MATCHER, "matcher", "matcher", PluginKind::InRig::One);
         k.versions = {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}};
         k.entries.push_back({"compute", offsetof(T, compute), true, kCompute});
         k.entries.push_back({"disparity_range", offsetof(T, disparity_range), false, kRange});

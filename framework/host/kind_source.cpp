@@ -268,7 +268,7 @@ std::string Source::enumerateDevices(const PluginRecord &record) {
 const PluginKind &sourceKind() {
     using T = binocle_source_api;
     static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_STEREO_SOURCE, "source", "source", false);
+        PluginKind k = tableKind<T>(BINOCLE_KIND_STEREO_SOURCE, "source", "source", PluginKind::InRig::One);
         k.versions = {{1, BINOCLE_END_OF(T, enumerate_devices), "enumerate_devices"}};
         k.entries.insert(k.entries.end(), {{"start", offsetof(T, start), false, kStart},
                                            {"stop", offsetof(T, stop), false, kStop},

@@ -4,20 +4,28 @@
 
 #include "core/error.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 namespace binocle {
 
-// The kinds' own descriptors (kind_<name>.cpp). A new kind adds its line here and in
-// the list below, and nothing else in the host but its own files.
-const PluginKind &sourceKind();
-const PluginKind &matcherKind();
-const PluginKind &transformKind();
-const PluginKind &evaluatorKind();
+// Every kind's descriptor, one per kind_<name>.cpp; the list is generated from those
+// file names (framework/CMakeLists.txt), so a new kind edits no list.
+std::vector<const PluginKind *> kindsByFile();
 
 const std::vector<const PluginKind *> &pluginKinds() {
-    static const std::vector<const PluginKind *> kinds = {&sourceKind(), &matcherKind(), &transformKind(), &evaluatorKind()};
+    static const std::vector<const PluginKind *> kinds = [] {
+        std::vector<const PluginKind *> k = kindsByFile();
+        std::sort(k.begin(), k.end(), [](const PluginKind *a, const PluginKind *b) { return a->kind < b->kind; });
+        return k;
+    }();
     return kinds;
+}
+
+const PluginKind *pluginKindNamed(const std::string &name) {
+    for (const PluginKind *k : pluginKinds())
+        if (name == k->name) return k;
+    return nullptr;
 }
 
 const PluginKind *pluginKind(int32_t kind) {

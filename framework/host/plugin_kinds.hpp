@@ -43,7 +43,10 @@ struct PluginKind {
     int32_t kind = 0;           // BINOCLE_KIND_*
     const char *name = "";      // "matcher": messages, `binocle plugins`, conformance
     const char *rigKey = "";    // its key in a rig file: "matcher", "transforms"
-    bool listInRig = false;     // the rig key holds a list of plugin blocks
+    // How a rig file holds blocks of this kind under rigKey: exactly one (a rig without
+    // it is refused), at most one, or a list. Config reads every kind's blocks this way.
+    enum class InRig { One, Optional, List };
+    InRig inRig = InRig::One;
     size_t tableSize = 0;       // the kind's table as this host knows it (its API version)
     size_t paramsOffset = 0;    // where `params` and `param_count` sit in the table
     size_t paramCountOffset = 0;
@@ -69,12 +72,12 @@ struct PluginKind {
 // A descriptor with what every kind's table has: the header, its settings table, and
 // create, destroy and last_error (mandatory). The kind adds its versions and calls.
 template <class Table>
-PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, bool listInRig) {
+PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, PluginKind::InRig inRig) {
     PluginKind k;
     k.kind = kind;
     k.name = name;
     k.rigKey = rigKey;
-    k.listInRig = listInRig;
+    k.inRig = inRig;
     k.tableSize = sizeof(Table);
     k.paramsOffset = offsetof(Table, params);
     k.paramCountOffset = offsetof(Table, param_count);
@@ -88,6 +91,8 @@ PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, bool li
 const std::vector<const PluginKind *> &pluginKinds();
 // nullptr for a kind this host does not know.
 const PluginKind *pluginKind(int32_t kind);
+// The kind of that name ("matcher"); nullptr when there is none.
+const PluginKind *pluginKindNamed(const std::string &name);
 // The kind's descriptor; throws Error for an unknown kind.
 const PluginKind &requireKind(int32_t kind);
 

@@ -84,4 +84,21 @@ std::string nearestWord(const std::string &word, const std::vector<std::string> 
     return best;
 }
 
+std::string xmlEscape(std::string_view s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        case '\'': out += "&apos;"; break;
+        default:
+            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r') out += ' ';
+            else out += c;
+        }
+    }
+    return out;
+}
+
 } // namespace binocle::input

@@ -36,4 +36,9 @@ bool isSafeName(std::string_view name, std::string *why = nullptr);
 // or "" when none is close: the "did you mean" of every message about a name.
 std::string nearestWord(const std::string &word, const std::vector<std::string> &candidates);
 
+// `s` with &, <, >, " and ' escaped, and the control characters XML 1.0 refuses (all
+// below 0x20 but tab, newline and carriage return) made spaces: for XML (JUnit, SVG) and
+// HTML text and attribute values.
+std::string xmlEscape(std::string_view s);
+
 } // namespace binocle::input

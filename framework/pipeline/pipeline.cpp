@@ -78,11 +78,11 @@ std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
 } // namespace
 
 Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
-    source_ = std::make_unique<Source>(*rig.source.record, rig.source.params);
+    source_ = std::make_unique<Source>(*rig.source().record, rig.source().params);
     for (int i = 0; i < rig.runtime.matcher_instances; ++i)
-        matchers_.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
-    for (const auto &t : rig.transforms) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
-    for (const auto &e : rig.evaluators) evaluators_.push_back(makeEvaluator(e));
+        matchers_.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
+    for (const auto &t : rig.transforms()) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
+    for (const auto &e : rig.evaluators()) evaluators_.push_back(makeEvaluator(e));
     disparityRange_ = askDisparityRange(*matchers_.front());
 }
 
@@ -135,22 +135,22 @@ void Pipeline::reconfigure(const RigConfig &rig) {
     // Everything new is created first: a refusal throws before anything is replaced.
     std::unique_ptr<Source> source;
     std::vector<std::unique_ptr<Matcher>> matchers;
-    std::vector<std::unique_ptr<CloudTransform>> transforms(rig.transforms.size());
-    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators(rig.evaluators.size());
-    const bool newSource = !sameBlock(rig.source, rig_.source) || rig.calibration_file != rig_.calibration_file;
-    if (newSource) source = std::make_unique<Source>(*rig.source.record, rig.source.params);
+    std::vector<std::unique_ptr<CloudTransform>> transforms(rig.transforms().size());
+    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators(rig.evaluators().size());
+    const bool newSource = !sameBlock(rig.source(), rig_.source()) || rig.calibration_file != rig_.calibration_file;
+    if (newSource) source = std::make_unique<Source>(*rig.source().record, rig.source().params);
     // As many instances as the stage has threads (runtime.matcher_instances is read when
     // the pipeline is made).
-    if (!sameBlock(rig.matcher, rig_.matcher))
+    if (!sameBlock(rig.matcher(), rig_.matcher()))
         for (size_t i = 0; i < matchers_.size(); ++i)
-            matchers.push_back(std::make_unique<Matcher>(*rig.matcher.record, rig.matcher.params));
+            matchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
     const std::pair<int32_t, int32_t> range = matchers.empty() ? disparityRange_ : askDisparityRange(*matchers.front());
-    for (size_t i = 0; i < rig.transforms.size(); ++i)
-        if (i >= rig_.transforms.size() || !sameBlock(rig.transforms[i], rig_.transforms[i]))
-            transforms[i] = std::make_unique<CloudTransform>(*rig.transforms[i].record, rig.transforms[i].params);
-    for (size_t i = 0; i < rig.evaluators.size(); ++i)
-        if (i >= rig_.evaluators.size() || !sameBlock(rig.evaluators[i], rig_.evaluators[i]))
-            evaluators[i] = makeEvaluator(rig.evaluators[i]);
+    for (size_t i = 0; i < rig.transforms().size(); ++i)
+        if (i >= rig_.transforms().size() || !sameBlock(rig.transforms()[i], rig_.transforms()[i]))
+            transforms[i] = std::make_unique<CloudTransform>(*rig.transforms()[i].record, rig.transforms()[i].params);
+    for (size_t i = 0; i < rig.evaluators().size(); ++i)
+        if (i >= rig_.evaluators().size() || !sameBlock(rig.evaluators()[i], rig_.evaluators()[i]))
+            evaluators[i] = makeEvaluator(rig.evaluators()[i]);
     if (source && sourceStarted_) {
         // A camera is held by one instance at a time: the old one lets go first, and
         // takes the device back when the new one cannot start.
@@ -189,19 +189,19 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
         calibrationYaml_ = source_->calibration();
         if (calibrationYaml_.empty())
             throw Error(rig_.file + ": no calibration: the rig names no 'calibration:' file and source plugin '" +
-                        rig_.source.plugin + "' publishes none (run `binocle calibrate`, or add calibration: FILE)");
-        calibration_ = StereoCalibration::fromYaml(calibrationYaml_, "calibration published by source '" + rig_.source.plugin + "'");
+                        rig_.source().plugin + "' publishes none (run `binocle calibrate`, or add calibration: FILE)");
+        calibration_ = StereoCalibration::fromYaml(calibrationYaml_, "calibration published by source '" + rig_.source().plugin + "'");
     }
     // Geometry check before the first frame: a calibration made for another image size,
     // with the cameras swapped or for another baseline gives a collapsed cloud or
     // negative disparities.
     GeometryExpectation expected;
     expected.image_size = imageSize;
-    expected.baseline_mm = statedGeometry(rig_.source).baseline_mm;
-    expected.source = rig_.source.plugin;
+    expected.baseline_mm = statedGeometry(rig_.source()).baseline_mm;
+    expected.source = rig_.source().plugin;
     checkGeometry(calibration_, expected,
                   rig_.calibration_file ? "calibration " + *rig_.calibration_file
-                                        : "the calibration published by source '" + rig_.source.plugin + "'");
+                                        : "the calibration published by source '" + rig_.source().plugin + "'");
     if (!calibration_.rectified) {
         cv::initUndistortRectifyMap(calibration_.M1, calibration_.D1, calibration_.R1, calibration_.P1, imageSize, CV_32FC1,
                                     map1x_, map1y_);
@@ -220,7 +220,7 @@ void Pipeline::checkFrameSize(const LentFrame &frame, int64_t ordinal) const {
     if (left == imageSize_ && right == imageSize_) return;
     auto text = [](const cv::Size &z) { return std::to_string(z.width) + "x" + std::to_string(z.height); };
     throw Error("frame " + std::to_string(ordinal) + " (sequence " + std::to_string(frame.raw().sequence) + ") of source '" +
-                rig_.source.plugin + "': left image " + text(left) + ", right image " + text(right) + "; expected " +
+                rig_.source().plugin + "': left image " + text(left) + ", right image " + text(right) + "; expected " +
                 text(imageSize_) + " as the frames before it and the calibration (" +
                 (rig_.calibration_file ? *rig_.calibration_file : "published by the source") +
                 "): refusing to process it with the wrong geometry (did the source change its image size mid-run?)");

@@ -27,7 +27,7 @@ void putGroundPose(binocle_eval_input &in, const RigConfig &rig) {
     auto number = [](const binocle_param *p) {
         return p->type == BINOCLE_PARAM_INT ? static_cast<double>(p->i) : p->d;
     };
-    for (const auto &t : rig.transforms) {
+    for (const auto &t : rig.transforms()) {
         const binocle_param *h = t.params.find("camera_height_mm"), *i = t.params.find("inclination_deg");
         if (!h || !i) continue;
         in.ground_pose_known = 1;

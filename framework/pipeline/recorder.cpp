@@ -579,7 +579,7 @@ RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, 
 
 RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
                        const std::function<void(int64_t frames)> &onFrame) {
-    Source source(*rig.source.record, rig.source.params);
+    Source source(*rig.source().record, rig.source().params);
     std::string calibration;
     if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
     else calibration = source.calibration();

@@ -54,8 +54,8 @@ Json runHeader(const RigConfig &rig, RuntimeOptions::Policy policy, bool live) {
     Json summary = Json::object();
     summary["rig"] = rig.file;
     summary["name"] = rig.name;
-    summary["source"] = rig.source.plugin;
-    summary["matcher"] = rig.matcher.plugin;
+    summary["source"] = rig.source().plugin;
+    summary["matcher"] = rig.matcher().plugin;
     summary["units"] = {{"length", "mm"}, {"disparity", "px"}, {"disparity_png_scale", 256}};
     summary["runtime"] = {{"policy", policy == RuntimeOptions::Policy::Latest ? "latest" : "lossless"},
                           {"policy_from", rt.policy ? "rig" : live ? "source (live)" : "source (not live)"},

@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/image_io.hpp"
+#include "input/text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -64,7 +65,7 @@ public:
         os_ << "<text x=\"" << x << "\" y=\"" << y << "\" font-size=\"" << size << "\" fill=\"" << color(c)
             << "\" text-anchor=\"" << anchor << "\"";
         if (vertical) os_ << " transform=\"rotate(-90 " << x << " " << y << ")\"";
-        os_ << ">" << escapeXml(s) << "</text>\n";
+        os_ << ">" << input::xmlEscape(s) << "</text>\n";
     }
     std::string finish() { return os_.str() + "</svg>\n"; }
 
@@ -309,20 +310,6 @@ void writeChart(const std::string &stem, const BarChart &chart) {
 void writeChart(const std::string &stem, const ScatterChart &chart) {
     writeImage(stem + ".png", toImage(chart));
     writeFileAtomic(stem + ".svg", toSvg(chart));
-}
-
-std::string escapeXml(const std::string &s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '&': out += "&amp;"; break;
-        case '"': out += "&quot;"; break;
-        default: out += c;
-        }
-    }
-    return out;
 }
 
 } // namespace binocle

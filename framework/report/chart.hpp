@@ -52,9 +52,6 @@ cv::Mat toImage(const BarChart &chart, int width = 960, int height = 540);
 std::string toSvg(const ScatterChart &chart, int width = 800, int height = 560);
 cv::Mat toImage(const ScatterChart &chart, int width = 800, int height = 560);
 
-// `s` with <, >, & and " escaped, for SVG and HTML text and attributes.
-std::string escapeXml(const std::string &s);
-
 // Writes <stem>.png and <stem>.svg, atomically.
 void writeChart(const std::string &stem, const BarChart &chart);
 void writeChart(const std::string &stem, const ScatterChart &chart);

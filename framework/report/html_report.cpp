@@ -31,7 +31,7 @@ namespace {
 
 using OJson = nlohmann::ordered_json;
 
-std::string escape(const std::string &s) { return escapeXml(s); }
+std::string escape(const std::string &s) { return input::xmlEscape(s); }
 
 std::string readFile(const fs::path &p) {
     std::ifstream in(p, std::ios::binary);

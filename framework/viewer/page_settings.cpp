@@ -29,9 +29,9 @@ bool inside(const fs::path &p, const fs::path &folder) {
 } // namespace
 
 std::vector<std::pair<const PluginBlock *, std::string>> pluginBlocks(const RigConfig &rig) {
-    std::vector<std::pair<const PluginBlock *, std::string>> out = {{&rig.source, "source"}, {&rig.matcher, "matcher"}};
-    for (size_t i = 0; i < rig.transforms.size(); ++i) out.emplace_back(&rig.transforms[i], "transforms." + std::to_string(i));
-    for (size_t i = 0; i < rig.evaluators.size(); ++i) out.emplace_back(&rig.evaluators[i], "evaluators." + std::to_string(i));
+    std::vector<std::pair<const PluginBlock *, std::string>> out = {{&rig.source(), "source"}, {&rig.matcher(), "matcher"}};
+    for (size_t i = 0; i < rig.transforms().size(); ++i) out.emplace_back(&rig.transforms()[i], "transforms." + std::to_string(i));
+    for (size_t i = 0; i < rig.evaluators().size(); ++i) out.emplace_back(&rig.evaluators()[i], "evaluators." + std::to_string(i));
     return out;
 }
 

@@ -2,6 +2,7 @@
 // Rig YAML: validation against plugin tables, errors with file:line:col, --set overrides.
 #include "common/test_util.hpp"
 #include "config/rig_config.hpp"
+#include "host/plugin_kinds.hpp"
 #include "input/text.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
@@ -63,15 +64,32 @@ PluginHost *RigConfigTest::host_ = nullptr;
 TEST_F(RigConfigTest, ValidRigResolvesPluginsAndDefaults) {
     RigConfig r = loadRig(write(rig()), {}, *host_);
     EXPECT_EQ(r.name, "test");
-    EXPECT_EQ(r.source.plugin, "replay");
-    EXPECT_EQ(r.matcher.plugin, "sgbm");
-    ASSERT_NE(r.matcher.params.find("num_disparities"), nullptr);
-    EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 64);
-    EXPECT_EQ(r.matcher.params.find("num_disparities")->explicit_, 1);
+    EXPECT_EQ(r.source().plugin, "replay");
+    EXPECT_EQ(r.matcher().plugin, "sgbm");
+    ASSERT_NE(r.matcher().params.find("num_disparities"), nullptr);
+    EXPECT_EQ(r.matcher().params.find("num_disparities")->i, 64);
+    EXPECT_EQ(r.matcher().params.find("num_disparities")->explicit_, 1);
     // Every declared setting reaches the plugin, defaults marked as such.
-    EXPECT_EQ(r.matcher.params.size(), static_cast<int32_t>(r.matcher.record->params().size()));
-    ASSERT_EQ(r.transforms.size(), 1u);
-    EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 5.0);
+    EXPECT_EQ(r.matcher().params.size(), static_cast<int32_t>(r.matcher().record->params().size()));
+    ASSERT_EQ(r.transforms().size(), 1u);
+    EXPECT_DOUBLE_EQ(r.transforms()[0].params.find("inclination_deg")->d, 5.0);
+}
+
+TEST_F(RigConfigTest, EveryKindsBlocksAreReadWhereItsDescriptorSays) {
+    const RigConfig r = loadRig(write(rig()), {}, *host_);
+    for (const PluginKind *k : pluginKinds()) {
+        const auto &blocks = r.blocks(k->kind);
+        if (k->inRig == PluginKind::InRig::One) ASSERT_EQ(blocks.size(), 1u) << k->name;
+        for (size_t i = 0; i < blocks.size(); ++i) {
+            EXPECT_EQ(blocks[i].record->kind, k->kind) << k->name;
+            EXPECT_EQ(blocks[i].where, k->inRig == PluginKind::InRig::List ? std::string(k->rigKey) + "[" + std::to_string(i) + "]"
+                                                                           : std::string(k->rigKey));
+        }
+    }
+    EXPECT_TRUE(r.evaluators().empty()); // a list the rig leaves out is empty
+    // Every kind's rig key is a valid top-level key, named when another is misspelt.
+    const std::string err = errorOf(rig() + "matchr: {}\n");
+    for (const PluginKind *k : pluginKinds()) EXPECT_NE(err.find(k->rigKey), std::string::npos) << err;
 }
 
 TEST_F(RigConfigTest, MisspeltKeyNamesLineColumnAndValidKey) {
@@ -120,9 +138,9 @@ TEST_F(RigConfigTest, SetOverridesAnyValueAndIsNamedInErrors) {
                                          Override::parse("transforms.0.inclination_deg=10"),
                                          Override::parse("matcher.plugin=bm")},
                           *host_);
-    EXPECT_EQ(r.matcher.plugin, "bm");
-    EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 128);
-    EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 10.0);
+    EXPECT_EQ(r.matcher().plugin, "bm");
+    EXPECT_EQ(r.matcher().params.find("num_disparities")->i, 128);
+    EXPECT_DOUBLE_EQ(r.transforms()[0].params.find("inclination_deg")->d, 10.0);
     const std::string err = errorOf(rig(), {Override::parse("matcher.num_disparities=100")});
     EXPECT_NE(err.find("command line --set matcher.num_disparities=100"), std::string::npos) << err;
     EXPECT_THROW(Override::parse("novalue"), Error);
@@ -132,8 +150,8 @@ TEST_F(RigConfigTest, SetOverridesAnyValueAndIsNamedInErrors) {
 TEST_F(RigConfigTest, AWholeBlockSwappedWithSetIsLocatedOnTheCommandLine) {
     const std::string set = "matcher={plugin: bm, block_size: 4}";
     RigConfig r = loadRig(write(rig()), {Override::parse("matcher={plugin: bm, block_size: 7}")}, *host_);
-    EXPECT_EQ(r.matcher.plugin, "bm");
-    EXPECT_EQ(r.matcher.params.find("block_size")->i, 7);
+    EXPECT_EQ(r.matcher().plugin, "bm");
+    EXPECT_EQ(r.matcher().params.find("block_size")->i, 7);
     const std::string err = errorOf(rig(), {Override::parse(set)});
     EXPECT_NE(err.find("command line --set " + set + ": matcher.block_size"), std::string::npos) << err;
     EXPECT_EQ(err.find("rig.yaml:"), std::string::npos) << err;
@@ -143,8 +161,8 @@ TEST_F(RigConfigTest, SwappingBmForSgbmIsOneLine) {
     const std::string sgbm = rig("  plugin: sgbm\n  num_disparities: 64\n  block_size: 5\n");
     std::string bm = sgbm;
     bm.replace(bm.find("plugin: sgbm"), 12, "plugin: bm  ");
-    EXPECT_EQ(loadRig(write(sgbm), {}, *host_).matcher.plugin, "sgbm");
-    EXPECT_EQ(loadRig(write(bm), {}, *host_).matcher.plugin, "bm");
+    EXPECT_EQ(loadRig(write(sgbm), {}, *host_).matcher().plugin, "sgbm");
+    EXPECT_EQ(loadRig(write(bm), {}, *host_).matcher().plugin, "bm");
 }
 
 TEST_F(RigConfigTest, RelativePathsResolveAgainstTheRigFolder) {
@@ -294,9 +312,9 @@ TEST_F(RigConfigTest, PlainDecimalsAndZeroStillRead) {
                                 "runtime:\n  queue_depth: 10\noutputs:\n  max_range_mm: 0.5e5\n"),
                           {Override::parse("transforms.0.inclination_deg=0.5")}, *host_);
     EXPECT_EQ(r.runtime.queue_depth, 10);
-    EXPECT_EQ(r.matcher.params.find("num_disparities")->i, 128);
+    EXPECT_EQ(r.matcher().params.find("num_disparities")->i, 128);
     EXPECT_DOUBLE_EQ(r.outputs.max_range_mm, 50000);
-    EXPECT_DOUBLE_EQ(r.transforms[0].params.find("inclination_deg")->d, 0.5);
+    EXPECT_DOUBLE_EQ(r.transforms()[0].params.find("inclination_deg")->d, 0.5);
 }
 
 TEST_F(RigConfigTest, AMistakeInSetIsAnOverrideErrorAndOneInTheFileIsNot) {

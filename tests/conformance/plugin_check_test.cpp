@@ -2,7 +2,16 @@
 // `binocle plugin-check` as an author runs it: the mock fixtures pass, every broken
 // fixture fails with its reason (and the battery goes on past a crash or a hang), and the
 // JUnit report says the same.
+#include "conformance/kit.hpp"
 #include "host/fixture_host.hpp"
+#include "host/plugin_kinds.hpp"
+
+#include <set>
+
+namespace binocle::conformance {
+// The list generated from cases_<kind>.cpp (framework/CMakeLists.txt).
+std::vector<std::pair<const char *, void (*)(Battery &)>> familiesByFile();
+} // namespace binocle::conformance
 
 namespace binocle::test {
 namespace {
@@ -20,6 +29,16 @@ void expectFailure(const ProcessResult &r, const std::string &line) {
     ASSERT_TRUE(r.exited) << "plugin-check was killed by signal " << r.signal << "\n" << r.err;
     EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
     EXPECT_THAT(r.out, HasSubstr(line)) << r.err;
+}
+
+TEST(PluginCheck, EveryKindHasItsFamilyOfCases) {
+    std::set<std::string> families;
+    for (const auto &[name, cases] : conformance::familiesByFile()) {
+        EXPECT_NE(pluginKindNamed(name), nullptr) << "cases_" << name << ".cpp names no plugin kind";
+        EXPECT_NE(cases, nullptr) << name;
+        families.insert(name);
+    }
+    for (const PluginKind *k : pluginKinds()) EXPECT_EQ(families.count(k->name), 1u) << k->name << " has no cases_" << k->name << ".cpp";
 }
 
 TEST(PluginCheck, WorkingFixturesOfEveryKindPass) {

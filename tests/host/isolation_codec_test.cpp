@@ -46,18 +46,18 @@ struct StridedImage {
 
 TEST(IsolationCodec, RequestHeadRoundTrips) {
     wire::Writer w;
-    wire::putHead(w, {42, 7, 1u << 20});
+    wire::put(w, wire::RequestHead{42, 7, 1u << 20});
     w.put<int32_t>(-5);
     wire::Reader r(w.data());
-    const wire::RequestHead h = wire::getHead(r);
+    const wire::RequestHead h = wire::get<wire::RequestHead>(r);
     EXPECT_EQ(h.op, 42u);
     EXPECT_EQ(h.region, 7u);
     EXPECT_EQ(h.region_bytes, 1u << 20);
     EXPECT_EQ(r.get<int32_t>(), -5); // the operation's own fields follow the head
     wire::Writer none;
-    wire::putHead(none, wire::RequestHead{});
+    wire::put(none, wire::RequestHead{});
     wire::Reader rn(none.data());
-    EXPECT_EQ(wire::getHead(rn).region, wire::kNoRegion);
+    EXPECT_EQ(wire::get<wire::RequestHead>(rn).region, wire::kNoRegion);
 }
 
 TEST(IsolationCodec, CreateCarriesTheKindAndEverySettingType) {
@@ -88,7 +88,7 @@ TEST(IsolationCodec, LogMetricTextAndReplyRoundTrip) {
     {
         wire::Reader r(wire::encode(wire::LogMessage{wire::kFromOutput, BINOCLE_LOG_WARNING, "a line"}));
         EXPECT_EQ(r.get<uint32_t>(), wire::kLog);
-        const auto m = wire::getLog(r);
+        const auto m = wire::get<wire::LogMessage>(r);
         EXPECT_EQ(m.origin, wire::kFromOutput);
         EXPECT_EQ(m.level, BINOCLE_LOG_WARNING);
         EXPECT_EQ(m.text, "a line");
@@ -96,7 +96,7 @@ TEST(IsolationCodec, LogMetricTextAndReplyRoundTrip) {
     {
         wire::Reader r(wire::encode(wire::MetricMessage{"bad_px", 12.5, "%"}));
         EXPECT_EQ(r.get<uint32_t>(), wire::kMetric);
-        const auto m = wire::getMetric(r);
+        const auto m = wire::get<wire::MetricMessage>(r);
         EXPECT_EQ(m.name, "bad_px");
         EXPECT_EQ(m.value, 12.5);
         EXPECT_EQ(m.unit, "%");
@@ -104,7 +104,7 @@ TEST(IsolationCodec, LogMetricTextAndReplyRoundTrip) {
     {
         wire::Reader r(wire::encode(wire::TextMessage{"objects", "- {id: 1}\n"}));
         EXPECT_EQ(r.get<uint32_t>(), wire::kText);
-        const auto m = wire::getText(r);
+        const auto m = wire::get<wire::TextMessage>(r);
         EXPECT_EQ(m.name, "objects");
         EXPECT_EQ(m.text, "- {id: 1}\n");
     }
@@ -113,7 +113,7 @@ TEST(IsolationCodec, LogMetricTextAndReplyRoundTrip) {
         wire::putRange(payload, {-3, 64});
         wire::Reader r(wire::encodeReply(BINOCLE_ERR_BUSY, "all frames lent", payload.data()));
         EXPECT_EQ(r.get<uint32_t>(), wire::kReply);
-        const auto h = wire::getReplyHead(r);
+        const auto h = wire::get<wire::ReplyHead>(r);
         EXPECT_EQ(h.rc, BINOCLE_ERR_BUSY);
         EXPECT_EQ(h.message, "all frames lent");
         EXPECT_EQ(wire::getRange(r), std::make_pair(-3, 64));

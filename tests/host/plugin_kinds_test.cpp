@@ -29,6 +29,12 @@ TEST(PluginKinds, OneDescriptorPerKindOfTheAbi) {
     }
     EXPECT_THAT(names, ElementsAre("source", "matcher", "transform", "evaluator"));
     EXPECT_THAT(keys, ElementsAre("source", "matcher", "transforms", "evaluators"));
+    EXPECT_EQ(pluginKindNamed("transform"), pluginKind(BINOCLE_KIND_CLOUD_TRANSFORM));
+    EXPECT_EQ(pluginKindNamed("transforms"), nullptr);
+    EXPECT_EQ(requireKind(BINOCLE_KIND_STEREO_SOURCE).inRig, PluginKind::InRig::One);
+    EXPECT_EQ(requireKind(BINOCLE_KIND_MATCHER).inRig, PluginKind::InRig::One);
+    EXPECT_EQ(requireKind(BINOCLE_KIND_CLOUD_TRANSFORM).inRig, PluginKind::InRig::List);
+    EXPECT_EQ(requireKind(BINOCLE_KIND_EVALUATOR).inRig, PluginKind::InRig::List);
     EXPECT_EQ(pluginKind(99), nullptr);
     EXPECT_STREQ(kindName(99), "unknown");
     EXPECT_EQ(leastTableSize(99, 1), 0u);

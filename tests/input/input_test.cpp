@@ -97,6 +97,13 @@ std::vector<uint8_t> encode(const std::string &ext, const cv::Mat &m) {
     return out;
 }
 
+TEST(Text, XmlEscapeKeepsMarkupOutAndDropsWhatXmlRefuses) {
+    EXPECT_EQ(xmlEscape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
+    EXPECT_EQ(xmlEscape(std::string("bell\x07 nul", 9) + '\0' + "end"), "bell  nul end");
+    EXPECT_EQ(xmlEscape("tab\tline\nreturn\r"), "tab\tline\nreturn\r");
+    EXPECT_EQ(xmlEscape("sch\xC3\xA4rfe"), "sch\xC3\xA4rfe"); // UTF-8 passes as it is
+}
+
 TEST(ImageFile, HeadersGiveTheSizeAndCutFilesAreRefused) {
     cv::Mat m(48, 64, CV_8UC3);
     cv::randu(m, 0, 255);

@@ -861,10 +861,10 @@ TEST(GigeConfigs, ShippedRigsAreValid) {
     for (const char *name : {"gige-two-cameras.yaml", "gige-side-by-side.yaml"}) {
         const std::string file = std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/" + name;
         const binocle::RigConfig rig = binocle::loadRig(file, {}, host());
-        EXPECT_EQ(rig.source.plugin, "gige") << name;
-        EXPECT_EQ(rig.matcher.plugin, "sgbm") << name;
-        ASSERT_EQ(rig.transforms.size(), 1u) << name;
-        EXPECT_EQ(rig.transforms[0].plugin, "ground") << name;
+        EXPECT_EQ(rig.source().plugin, "gige") << name;
+        EXPECT_EQ(rig.matcher().plugin, "sgbm") << name;
+        ASSERT_EQ(rig.transforms().size(), 1u) << name;
+        EXPECT_EQ(rig.transforms()[0].plugin, "ground") << name;
     }
 }
 

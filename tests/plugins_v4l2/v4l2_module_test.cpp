@@ -61,11 +61,11 @@ TEST(V4l2Module, EnumeratesNoDeviceWhereThereIsNone) {
 TEST(V4l2Module, TheExampleRigIsValid) {
     const std::string file = std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/v4l2-uvc-side-by-side.yaml";
     const binocle::RigConfig rig = binocle::loadRig(file, {}, host());
-    EXPECT_EQ(rig.source.plugin, "v4l2");
-    EXPECT_EQ(rig.matcher.plugin, "sgbm");
-    ASSERT_EQ(rig.transforms.size(), 1u);
-    EXPECT_EQ(rig.transforms[0].plugin, "ground");
-    const binocle_param *layout = rig.source.params.find("layout");
+    EXPECT_EQ(rig.source().plugin, "v4l2");
+    EXPECT_EQ(rig.matcher().plugin, "sgbm");
+    ASSERT_EQ(rig.transforms().size(), 1u);
+    EXPECT_EQ(rig.transforms()[0].plugin, "ground");
+    const binocle_param *layout = rig.source().params.find("layout");
     ASSERT_TRUE(layout);
     EXPECT_STREQ(layout->s, "side_by_side");
 }

@@ -46,20 +46,20 @@ TEST(VidereModule, NoBusOrNoCameraGivesAClearError) {
 TEST(VidereModule, ThePapersHeadRigIsValid) {
     const std::string file = std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/videre-sth-mdcs2.yaml";
     const binocle::RigConfig rig = binocle::loadRig(file, {}, host());
-    EXPECT_EQ(rig.source.plugin, "videre1394");
-    const binocle_param *decimation = rig.source.params.find("decimation");
+    EXPECT_EQ(rig.source().plugin, "videre1394");
+    const binocle_param *decimation = rig.source().params.find("decimation");
     ASSERT_TRUE(decimation);
     EXPECT_EQ(decimation->i, 4);
-    EXPECT_EQ(rig.matcher.plugin, "sgbm");
-    ASSERT_EQ(rig.transforms.size(), 1u);
-    EXPECT_EQ(rig.transforms[0].plugin, "ground");
-    const binocle_param *height = rig.transforms[0].params.find("camera_height_mm");
+    EXPECT_EQ(rig.matcher().plugin, "sgbm");
+    ASSERT_EQ(rig.transforms().size(), 1u);
+    EXPECT_EQ(rig.transforms()[0].plugin, "ground");
+    const binocle_param *height = rig.transforms()[0].params.find("camera_height_mm");
     ASSERT_TRUE(height);
     EXPECT_EQ(height->d, 1500);
-    const binocle_param *inclination = rig.transforms[0].params.find("inclination_deg");
+    const binocle_param *inclination = rig.transforms()[0].params.find("inclination_deg");
     ASSERT_TRUE(inclination);
     EXPECT_EQ(inclination->d, 0);
-    EXPECT_TRUE(rig.evaluators.empty());
+    EXPECT_TRUE(rig.evaluators().empty());
 }
 
 } // namespace

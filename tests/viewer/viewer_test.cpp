@@ -271,7 +271,7 @@ TEST(PipelineReconfigure, MatcherChangesBetweenFrames) {
         EXPECT_EQ(r.stage_seconds[1].first, "match");
     });
     EXPECT_EQ(ranges, (std::vector<int32_t>{64, 128, 128}));
-    EXPECT_EQ(pipeline.rig().matcher.params.find("num_disparities")->i, 128);
+    EXPECT_EQ(pipeline.rig().matcher().params.find("num_disparities")->i, 128);
 }
 
 // With parallel matcher instances every one of them is replaced, and the hook runs only
