@@ -42,25 +42,33 @@ inline v_uint64 popcount64(const v_uint64 &a) {
 #endif
 }
 
-// ---- census ---------------------------------------------------------------------------
+// ---- census ----------------------------------------------------------------------------
 // kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
 // byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
-// one 64-bit word per pixel.
+// one 64-bit word per pixel. A plane is built in a register, its neighbours taken from
+// the highest bit down: doubling it and subtracting the mask (all ones = -1) shifts the
+// next bit in, with no read-modify-write of memory between two neighbours.
 void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
     const int rx = cw / 2, ry = ch / 2;
+    // Neighbour k: its row and its column offset, in the order of the bits.
+    const uint8_t *row[64];
+    int offset[64], count = 0;
+    for (int j = 0; j < ch; ++j)
+        for (int dx = -rx; dx <= rx; ++dx)
+            if (j != ry || dx != 0) {
+                row[count] = rows[j];
+                offset[count++] = dx;
+            }
     int x = 0;
     for (; x + kLanes8 <= width; x += kLanes8) {
         const v_uint8 centre = vx_load(rows[ry] + x);
         v_uint8 plane[8];
-        for (auto &p : plane) p = vx_setzero_u8();
-        int k = 0;
-        for (int j = 0; j < ch; ++j)
-            for (int dx = -rx; dx <= rx; ++dx) {
-                if (j == ry && dx == 0) continue;
-                const v_uint8 darker = vx_load(rows[j] + x + dx) < centre;
-                plane[k >> 3] = plane[k >> 3] | (darker & vx_setall_u8(static_cast<uint8_t>(1u << (k & 7))));
-                ++k;
-            }
+        for (int b = 0; b < 8; ++b) {
+            v_uint8 p = vx_setzero_u8();
+            for (int k = std::min(count, 8 * b + 8) - 1; k >= 8 * b; --k)
+                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(row[k] + x + offset[k]) < centre));
+            plane[b] = p;
+        }
         // bytes -> 16-bit pairs -> 32-bit quads -> 64-bit words, pixel order kept.
         v_uint8 z[8];
         for (int b = 0; b < 4; ++b) v_zip(plane[2 * b], plane[2 * b + 1], z[2 * b], z[2 * b + 1]);
@@ -449,34 +457,37 @@ struct Divider {
     int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
 };
 
+// The bits of lanes lo, lo + 1 and lo + 2 in the mask v_signmask gives of 16-bit lanes
+// seen as bytes (two bits a lane); lanes outside 0 .. kLanes16 - 1 have none.
+inline uint64_t threeLanes(int lo) {
+    if (lo <= -3 || lo >= kLanes16) return 0;
+    return lo >= 0 ? uint64_t(0x3F) << (2 * lo) : uint64_t(0x3F) >> (-2 * lo);
+}
+
 // One pixel's winner takes all, its least sum m already known.
-inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
-                     uint16_t *bestSum, uint16_t *disparity16) {
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp,
+                                                    const Divider &divide, int16_t *best, uint16_t *bestSum,
+                                                    uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    // One more pass finds the lowest d holding the least sum and counts the sums below
-    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
+    // One more pass finds the lowest d holding the least sum and marks the sums below the
+    // uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
     const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
     const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
     const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
     int b = -1;
-    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
+    uint64_t below[kDispAlign * 8 / kLanes16]; // per vector, the byte mask of its lanes under the threshold
     // Backwards, without a branch on where the least sum lies (it is anywhere: a branch
     // would be mispredicted at every other pixel): the lowest match is the last kept.
-    for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
-        const v_uint16 v = vx_load(s + d);
+    for (int i = whole / kLanes16 - 1; i >= 0; --i) {
+        const v_uint16 v = vx_load(s + i * kLanes16);
         // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
         // the 16-bit mask takes a pack and a permute first.
         const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
-        b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
-        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
+        b = eq != 0 ? i * kLanes16 + __builtin_ctzll(eq) / 2 : b;
+        below[i] = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v < vt)));
     }
-    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
-    // bytes (one sum of absolute differences) is the sum of the lanes.
-    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
-    for (int d = whole; d < wp.numDisp; ++d) {
+    for (int d = whole; d < wp.numDisp; ++d)
         if (b < 0 && s[d] == m) b = d;
-        below += s[d] < threshold;
-    }
     bestSum[x] = static_cast<uint16_t>(m);
     if (x - wp.minDisparity - b < 0) {
         best[x] = -1;
@@ -484,9 +495,11 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         return;
     }
     best[x] = static_cast<int16_t>(b);
-    // Those at b - 1, b, b + 1 do not count.
-    for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
-    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+    // Unique when no sum away from b by more than 1 is under the threshold.
+    uint64_t others = 0;
+    for (int i = 0; i < whole / kLanes16; ++i) others |= below[i] & ~threeLanes(b - 1 - i * kLanes16);
+    for (int d = whole; d < wp.numDisp; ++d) others |= std::abs(d - b) > 1 && s[d] < threshold;
+    disparity16[x] = others == 0 ? refinedDisparity16(s, b, wp) : 0;
 }
 
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
@@ -517,17 +530,22 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const int whole = wp.numDisp / kLanes16 * kLanes16;
     const Divider divide(100 - wp.uniquenessPercent);
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    // Local copies: the stores through uint8_t pointers below may alias anything, so the
+    // compiler would otherwise load every field again at each pixel.
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
+    const WtaParams w = wp;
     alignas(64) uint16_t local[kDispAlign * 8];
     for (int x = 0; x < width; ++x) {
-        const bool has = paths.prevL[0] != nullptr;
-        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(x) * stride + 1 : freshPath();
-        const int minPrev = has ? paths.prevMin[0][x] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[x])] : pp.p2Lut[0];
+        const bool has = prevL != nullptr;
+        const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
+        const int minPrev = has ? prevMin[x] : 255;
+        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
         v_uint8 least = vx_setall_u8(255);
         v_uint16 leastSum = vx_setall_u16(0xFFFF);
-        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
         const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
@@ -548,10 +566,10 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             if (d < whole) leastSum = v_min(leastSum, lo);
             if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
         }
-        paths.curMin[0][x] = v_reduce_min(least);
+        curMin[x] = v_reduce_min(least);
         int m = v_reduce_min(leastSum);
-        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, local[d]);
-        wtaPixel(local, m, x, wp, divide, best, bestSum, disparity16);
+        for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, local[d]);
+        wtaPixel(local, m, x, w, divide, best, bestSum, disparity16);
     }
 }
 
