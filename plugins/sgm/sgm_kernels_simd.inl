@@ -42,6 +42,31 @@ inline v_uint64 popcount64(const v_uint64 &a) {
 #endif
 }
 
+// The least byte of a vector: every path's minimum at every pixel, on the serial chain of
+// the horizontal paths. With AVX2 the pairs of bytes are first folded into 16-bit lanes
+// (shifting a 16-bit lane right by 8 leaves its high byte 0, so the minimum's high byte
+// is 0 too), then SSE4.1's PHMINPOSUW takes the least of eight 16-bit lanes at once: six
+// instructions where v_reduce_min's halvings take ten.
+inline int leastByte(const v_uint8 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFF;
+#else
+    return v_reduce_min(a);
+#endif
+}
+
+// The least 16-bit lane, the same way.
+inline int leastWord(const v_uint16 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    const __m128i v = _mm_min_epu16(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFFFF;
+#else
+    return v_reduce_min(a);
+#endif
+}
+
 // ---- census ----------------------------------------------------------------------------
 // kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
 // byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
@@ -201,7 +226,7 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
                     least[i] = v_min(least[i], l);
                 }
             }
-            for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+            for (int i = 0; i < n; ++i) paths.curMin[i][x] = leastByte(least[i]);
             continue;
         }
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
@@ -225,7 +250,7 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
             v_store(s0 + d, lo);
             v_store(s0 + d + kLanes16, hi);
         }
-        for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+        for (int i = 0; i < n; ++i) paths.curMin[i][x] = leastByte(least[i]);
     }
 }
 
@@ -256,7 +281,7 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
             v_store(out + d, l);
             least = v_min(least, l);
         }
-        paths.curMin[0][x] = v_reduce_min(least);
+        paths.curMin[0][x] = leastByte(least);
     }
 }
 
@@ -316,7 +341,7 @@ struct HorizontalChain {
                 v_store(s + kLanes16, vx_load(s + kLanes16) + hi);
             }
         }
-        minPrev = v_reduce_min(least);
+        minPrev = leastByte(least);
         std::swap(prev, cur);
         previousX = x;
     }
@@ -352,7 +377,7 @@ struct RegisterChain {
             cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
             least = v_min(least, cur[c]);
         }
-        minPrev = v_reduce_min(least);
+        minPrev = leastByte(least);
         previousX = x;
 #pragma GCC unroll 8
         for (int c = 0; c < Chunks; ++c) {
@@ -457,37 +482,34 @@ struct Divider {
     int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
 };
 
-// The bits of lanes lo, lo + 1 and lo + 2 in the mask v_signmask gives of 16-bit lanes
-// seen as bytes (two bits a lane); lanes outside 0 .. kLanes16 - 1 have none.
-inline uint64_t threeLanes(int lo) {
-    if (lo <= -3 || lo >= kLanes16) return 0;
-    return lo >= 0 ? uint64_t(0x3F) << (2 * lo) : uint64_t(0x3F) >> (-2 * lo);
-}
-
 // One pixel's winner takes all, its least sum m already known.
-inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp,
-                                                    const Divider &divide, int16_t *best, uint16_t *bestSum,
-                                                    uint16_t *disparity16) {
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
+                     uint16_t *bestSum, uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    // One more pass finds the lowest d holding the least sum and marks the sums below the
-    // uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
+    // One more pass finds the lowest d holding the least sum and counts the sums below
+    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
     const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
     const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
     const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
     int b = -1;
-    uint64_t below[kDispAlign * 8 / kLanes16]; // per vector, the byte mask of its lanes under the threshold
+    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
     // Backwards, without a branch on where the least sum lies (it is anywhere: a branch
     // would be mispredicted at every other pixel): the lowest match is the last kept.
-    for (int i = whole / kLanes16 - 1; i >= 0; --i) {
-        const v_uint16 v = vx_load(s + i * kLanes16);
+    for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
+        const v_uint16 v = vx_load(s + d);
         // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
         // the 16-bit mask takes a pack and a permute first.
         const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
-        b = eq != 0 ? i * kLanes16 + __builtin_ctzll(eq) / 2 : b;
-        below[i] = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v < vt)));
+        b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
+        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
     }
-    for (int d = whole; d < wp.numDisp; ++d)
+    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
+    // bytes (one sum of absolute differences) is the sum of the lanes.
+    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
+    for (int d = whole; d < wp.numDisp; ++d) {
         if (b < 0 && s[d] == m) b = d;
+        below += s[d] < threshold;
+    }
     bestSum[x] = static_cast<uint16_t>(m);
     if (x - wp.minDisparity - b < 0) {
         best[x] = -1;
@@ -495,11 +517,10 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         return;
     }
     best[x] = static_cast<int16_t>(b);
-    // Unique when no sum away from b by more than 1 is under the threshold.
-    uint64_t others = 0;
-    for (int i = 0; i < whole / kLanes16; ++i) others |= below[i] & ~threeLanes(b - 1 - i * kLanes16);
-    for (int d = whole; d < wp.numDisp; ++d) others |= std::abs(d - b) > 1 && s[d] < threshold;
-    disparity16[x] = others == 0 ? refinedDisparity16(s, b, wp) : 0;
+    // Those at b - 1, b, b + 1 do not count (without a loop: its trip count varies).
+    const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
+    below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
 }
 
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
@@ -510,7 +531,7 @@ void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, 
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
-        int m = v_reduce_min(least);
+        int m = leastWord(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
         wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
     }
@@ -535,41 +556,52 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     const WtaParams w = wp;
-    alignas(64) uint16_t local[kDispAlign * 8];
-    for (int x = 0; x < width; ++x) {
-        const bool has = prevL != nullptr;
-        const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
-        const int minPrev = has ? prevMin[x] : 255;
-        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
-        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
-        v_uint8 least = vx_setall_u8(255);
-        v_uint16 leastSum = vx_setall_u16(0xFFFF);
-        uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
-        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
-        const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
-        const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+    // The sums of a batch of pixels first, then their winners: a winner is a long chain
+    // of dependent steps (least sum, threshold, masks, lowest d, parabola), and the
+    // chains of neighbouring pixels, side by side in the instruction stream, overlap.
+    constexpr int kBatch = 8;
+    alignas(64) uint16_t local[kBatch][kDispAlign * 8];
+    int leastOf[kBatch];
+    for (int x0 = 0; x0 < width; x0 += kBatch) {
+        const int n = std::min(kBatch, width - x0);
+        for (int j = 0; j < n; ++j) {
+            const int x = x0 + j;
+            uint16_t *sums = local[j];
+            const bool has = prevL != nullptr;
+            const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
+            const int minPrev = has ? prevMin[x] : 255;
+            const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
+            const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+            const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            v_uint8 least = vx_setall_u8(255);
+            v_uint16 leastSum = vx_setall_u16(0xFFFF);
+            uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
+            const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+            const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
+            const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
 #pragma GCC unroll 8
-        for (int d = 0; d < paddedDisp; d += kLanes8) {
-            const uint8_t *q = prev + d;
-            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
-            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
-            v_store(out + d, l);
-            least = v_min(least, l);
-            v_uint16 l0, l1, k0lo, k0hi;
-            v_expand(l, l0, l1);
-            v_expand(vx_load(k0 + d), k0lo, k0hi);
-            const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
-            const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
-            v_store(local + d, lo);
-            v_store(local + d + kLanes16, hi);
-            if (d < whole) leastSum = v_min(leastSum, lo);
-            if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
+            for (int d = 0; d < paddedDisp; d += kLanes8) {
+                const uint8_t *q = prev + d;
+                const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+                const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+                v_store(out + d, l);
+                least = v_min(least, l);
+                v_uint16 l0, l1, k0lo, k0hi;
+                v_expand(l, l0, l1);
+                v_expand(vx_load(k0 + d), k0lo, k0hi);
+                const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
+                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
+                v_store(sums + d, lo);
+                v_store(sums + d + kLanes16, hi);
+                if (d < whole) leastSum = v_min(leastSum, lo);
+                if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
+            }
+            curMin[x] = leastByte(least);
+            int m = leastWord(leastSum);
+            for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
+            leastOf[j] = m;
         }
-        curMin[x] = v_reduce_min(least);
-        int m = v_reduce_min(leastSum);
-        for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, local[d]);
-        wtaPixel(local, m, x, w, divide, best, bestSum, disparity16);
+        for (int j = 0; j < n; ++j) wtaPixel(local[j], leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
     }
 }
 
