@@ -25,7 +25,7 @@ struct Settings {
     int disp12MaxDiff = 1;      // -1: no left-right check
     bool subpixel = true;
     int medianPx = 5;           // 1: none
-    int stripes = 4;
+    int stripes = 2;
     double maxMemoryBytes = 2048.0 * 1048576.0;
 };
 
