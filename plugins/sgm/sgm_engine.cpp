@@ -91,17 +91,22 @@ void Engine::prepare(int width, int height) {
     ++allocations_;
 }
 
-// The census of every row, rows in parallel. The image is first padded by replication so
-// that the window never leaves it.
-void Engine::censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census) {
+// The census of every row of both images, rows in parallel (one parallel loop: one wait
+// for the slowest thread, not two). The images are first padded by replication so that
+// the window never leaves them.
+void Engine::census(const cv::Mat &left, const cv::Mat &right) {
     const int rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
-    cv::copyMakeBorder(grey, padded, ry, ry, rx, rx, cv::BORDER_REPLICATE);
-    cv::parallel_for_(cv::Range(0, height_), [&](const cv::Range &range) {
+    cv::copyMakeBorder(left, paddedLeft_, ry, ry, rx, rx, cv::BORDER_REPLICATE);
+    cv::copyMakeBorder(right, paddedRight_, ry, ry, rx, rx, cv::BORDER_REPLICATE);
+    cv::parallel_for_(cv::Range(0, 2 * height_), [&](const cv::Range &range) {
         const uint8_t *rows[16];
-        for (int y = range.start; y < range.end; ++y) {
+        for (int i = range.start; i < range.end; ++i) {
+            const bool isLeft = i < height_;
+            const int y = isLeft ? i : i - height_;
+            const cv::Mat &padded = isLeft ? paddedLeft_ : paddedRight_;
             for (int j = 0; j < settings_.censusHeight; ++j) rows[j] = padded.ptr<uint8_t>(y + j) + rx;
             kernels_.censusRow(rows, width_, settings_.censusWidth, settings_.censusHeight,
-                               census.data() + static_cast<size_t>(y) * width_);
+                               (isLeft ? censusLeft_ : censusRight_).data() + static_cast<size_t>(y) * width_);
         }
     });
 }
@@ -126,20 +131,25 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
     uint16_t *out = fixed_.ptr<uint16_t>(y);
     std::fill(s.rightBest.begin(), s.rightBest.end(), -1);
     std::fill(s.rightSum.begin(), s.rightSum.end(), 0xFFFF);
+    // Selects instead of branches on the sums and the differences, which go either way
+    // (mispredicted often).
+    const int16_t *best = s.best.data();
+    int16_t *rightBest = s.rightBest.data();
+    uint16_t *rightSum = s.rightSum.data();
     for (int x = 0; x < width_; ++x) {
-        const int d = s.best[x];
-        if (d < 0) continue;
+        const int d = best[x];
+        if (d < 0) continue; // no candidate: the left margin only
         const int xr = x - settings_.minDisparity - d;
-        if (s.bestSum[x] < s.rightSum[xr]) {
-            s.rightSum[xr] = s.bestSum[x];
-            s.rightBest[xr] = static_cast<int16_t>(d);
-        }
+        const uint16_t sum = s.bestSum[x], held = rightSum[xr];
+        const bool better = sum < held;
+        rightSum[xr] = better ? sum : held;
+        rightBest[xr] = better ? static_cast<int16_t>(d) : rightBest[xr];
     }
     for (int x = 0; x < width_; ++x) {
-        const int d = s.best[x];
-        if (d < 0 || out[x] == 0) continue;
+        const int d = best[x];
+        if (d < 0) continue;
         const int xr = x - settings_.minDisparity - d;
-        if (std::abs(s.rightBest[xr] - d) > settings_.disp12MaxDiff) out[x] = 0;
+        out[x] = std::abs(rightBest[xr] - d) > settings_.disp12MaxDiff ? 0 : out[x];
     }
 }
 
@@ -228,8 +238,7 @@ const cv::Mat &Engine::computeFixed(const cv::Mat &left, const cv::Mat &right) {
     prepare(left.cols, left.rows);
     greyLeft_ = left;
     greyRight_ = right;
-    censusImage(left, paddedLeft_, censusLeft_);
-    censusImage(right, paddedRight_, censusRight_);
+    census(left, right);
     const int n = static_cast<int>(stripes_.size());
     cv::parallel_for_(cv::Range(0, n), [&](const cv::Range &range) {
         for (int i = range.start; i < range.end; ++i)

@@ -60,7 +60,7 @@ private:
         std::vector<uint16_t> bestSum, rightSum;
     };
     void prepare(int width, int height);
-    void censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census);
+    void census(const cv::Mat &left, const cv::Mat &right);
     void matchStripe(int stripe, int y0, int y1);
     // The costs of row y: computed into the stripe's row (or into the cost volume, for a
     // row of the stripe's own in the pass down), or read back from the volume.
