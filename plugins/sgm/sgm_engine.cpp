@@ -87,7 +87,13 @@ void Engine::prepare(int width, int height) {
         s.rightSum.assign(w, 0);
     }
     fixed_.create(height, width, CV_16UC1);
-    filtered_.create(height, width, CV_16UC1);
+    // Bands of the median and conversion: their output rows (a band and the rows around it).
+    bandOut_.assign(static_cast<size_t>(std::clamp(height / 32, 1, kFinishBands)), cv::Mat());
+    for (size_t i = 0; i < bandOut_.size(); ++i) {
+        const int n = static_cast<int>(bandOut_.size()), y0 = height * static_cast<int>(i) / n;
+        const int y1 = height * (static_cast<int>(i) + 1) / n, k = settings_.medianPx / 2;
+        bandOut_[i].create(std::min(height, y1 + k) - std::max(0, y0 - k), width, CV_16UC1);
+    }
     ++allocations_;
 }
 
@@ -251,18 +257,30 @@ void Engine::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispari
     CV_Assert(disparity.type() == CV_32FC1 && disparity.size() == left.size());
     computeFixed(left, right);
     // A small median removes isolated outliers; an invalid pixel (0) among valid ones
-    // is outvoted, a valid one among invalid ones is dropped.
-    const cv::Mat *result = &fixed_;
-    if (settings_.medianPx > 1) {
-        cv::medianBlur(fixed_, filtered_, settings_.medianPx);
-        result = &filtered_;
-    }
+    // is outvoted, a valid one among invalid ones is dropped. Median and conversion run
+    // in bands of rows in parallel (in one thread they were a tenth of the frame's time
+    // on 2 threads); each band's median reads the medianPx / 2 rows around it, so the
+    // result is that of the whole image.
+    const int k = settings_.medianPx / 2, bands = static_cast<int>(bandOut_.size());
     const float scale = 1.0f / 16;
-    for (int y = 0; y < height_; ++y) {
-        const uint16_t *src = result->ptr<uint16_t>(y);
-        float *dst = disparity.ptr<float>(y);
-        for (int x = 0; x < width_; ++x) dst[x] = src[x] == 0 ? invalid : static_cast<float>(src[x]) * scale;
-    }
+    cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range &range) {
+        for (int i = range.start; i < range.end; ++i) {
+            const int y0 = height_ * i / bands, y1 = height_ * (i + 1) / bands;
+            const int from = std::max(0, y0 - k), to = std::min(height_, y1 + k);
+            const cv::Mat *result = &fixed_;
+            int first = 0; // the row of result that holds image row 0
+            if (k > 0) {
+                cv::medianBlur(fixed_.rowRange(from, to), bandOut_[static_cast<size_t>(i)], settings_.medianPx);
+                result = &bandOut_[static_cast<size_t>(i)];
+                first = -from;
+            }
+            for (int y = y0; y < y1; ++y) {
+                const uint16_t *src = result->ptr<uint16_t>(y + first);
+                float *dst = disparity.ptr<float>(y);
+                for (int x = 0; x < width_; ++x) dst[x] = src[x] == 0 ? invalid : static_cast<float>(src[x]) * scale;
+            }
+        }
+    });
 }
 
 } // namespace sgm

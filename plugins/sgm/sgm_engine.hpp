@@ -32,6 +32,8 @@ struct Settings {
 // Rows a stripe runs its vertical paths above (and below) its own rows before they count:
 // stripes are matched independently, in parallel.
 constexpr int kStripeOverlapRows = 16;
+// At most this many bands of rows for the median and the conversion, run in parallel.
+constexpr int kFinishBands = 8;
 
 class Engine {
 public:
@@ -84,7 +86,8 @@ private:
     bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2Lut_[256];
-    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_, filtered_;
+    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
+    std::vector<cv::Mat> bandOut_; // per band of the median: its filtered rows
     std::vector<uint64_t> censusLeft_, censusRight_;
     std::vector<uint16_t> volume_;  // 8 paths: the pass down's sums
     std::vector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
