@@ -262,15 +262,18 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
     const int stride = pathStride(paddedDisp);
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     const int dx = paths.dx[0];
+    // Local copies: stores through uint8_t pointers may alias the caller's structures.
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     for (int x = 0; x < width; ++x) {
         const int xp = x + dx;
-        const bool has = paths.prevL[0] && xp >= 0 && xp < width;
-        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(xp) * stride + 1 : freshPath();
-        const int minPrev = has ? paths.prevMin[0][xp] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+        const bool has = prevL && xp >= 0 && xp < width;
+        const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
+        const int minPrev = has ? prevMin[xp] : 255;
+        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[xp])] : lut[0];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
-        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = vx_setall_u8(255);
 #pragma GCC unroll 8
@@ -281,7 +284,7 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
             v_store(out + d, l);
             least = v_min(least, l);
         }
-        paths.curMin[0][x] = leastByte(least);
+        curMin[x] = leastByte(least);
     }
 }
 
@@ -401,15 +404,25 @@ template <int Chunks, int Rows>
 void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
                   const PathParams &pp, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    const PathParams params = pp; // a local copy: the sums' stores cannot alias it
+    const uint8_t *rowCost[Rows], *rowGrey[Rows];
+    uint16_t *rowSum[Rows];
+    for (int r = 0; r < Rows; ++r) {
+        rowCost[r] = cost[r];
+        rowGrey[r] = grey[r];
+        rowSum[r] = sum[r];
+    }
     RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
         // Sums are exact (at most 8 x 255), so the order of the additions does not
         // matter; the first path to reach a pixel stores instead of adding.
 #pragma GCC unroll 2
-        for (int r = 0; r < Rows; ++r) forward[r].step(cost[r], paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+        for (int r = 0; r < Rows; ++r)
+            forward[r].step(rowCost[r], paddedDisp, i, rowGrey[r], params, p1, rowSum[r], initSum && i <= xb);
 #pragma GCC unroll 2
-        for (int r = 0; r < Rows; ++r) backward[r].step(cost[r], paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
+        for (int r = 0; r < Rows; ++r)
+            backward[r].step(rowCost[r], paddedDisp, xb, rowGrey[r], params, p1, rowSum[r], initSum && xb > i);
     }
 }
 
