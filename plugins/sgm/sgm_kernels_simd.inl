@@ -73,25 +73,36 @@ inline int leastWord(const v_uint16 &a) {
 // one 64-bit word per pixel. A plane is built in a register, its neighbours taken from
 // the highest bit down: doubling it and subtracting the mask (all ones = -1) shifts the
 // next bit in, with no read-modify-write of memory between two neighbours.
-void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
-    const int rx = cw / 2, ry = ch / 2;
+// CW, CH: the window when known at compile time (the default 9 x 7: the loops unroll and
+// every neighbour's row and column become constants), 0 when not.
+template <int CW, int CH>
+void censusRowOf(const uint8_t *const *rows, int width, int runtimeCw, int runtimeCh, uint64_t *out) {
+    const int cw = CW > 0 ? CW : runtimeCw, ch = CH > 0 ? CH : runtimeCh;
+    const int rx = cw / 2, ry = ch / 2, count = cw * ch - 1;
     // Neighbour k: its row and its column offset, in the order of the bits.
     const uint8_t *row[64];
-    int offset[64], count = 0;
-    for (int j = 0; j < ch; ++j)
-        for (int dx = -rx; dx <= rx; ++dx)
-            if (j != ry || dx != 0) {
-                row[count] = rows[j];
-                offset[count++] = dx;
-            }
+    int offset[64];
+    for (int k = 0; k < count; ++k) {
+        const int n = k < ry * cw + rx ? k : k + 1; // the centre skipped
+        row[k] = rows[n / cw];
+        offset[k] = n % cw - rx;
+    }
     int x = 0;
     for (; x + kLanes8 <= width; x += kLanes8) {
         const v_uint8 centre = vx_load(rows[ry] + x);
         v_uint8 plane[8];
+#pragma GCC unroll 8
         for (int b = 0; b < 8; ++b) {
             v_uint8 p = vx_setzero_u8();
-            for (int k = std::min(count, 8 * b + 8) - 1; k >= 8 * b; --k)
-                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(row[k] + x + offset[k]) < centre));
+#pragma GCC unroll 8
+            for (int i = 7; i >= 0; --i) {
+                const int k = 8 * b + i;
+                if (k >= count) continue;
+                const uint8_t *at = CW > 0 ? rows[(k < ry * cw + rx ? k : k + 1) / cw] +
+                                                 ((k < ry * cw + rx ? k : k + 1) % cw - rx)
+                                           : row[k] + offset[k];
+                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(at + x) < centre));
+            }
             plane[b] = p;
         }
         // bytes -> 16-bit pairs -> 32-bit quads -> 64-bit words, pixel order kept.
@@ -122,6 +133,11 @@ void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *
             }
         out[x] = bits;
     }
+}
+
+void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
+    if (cw == 9 && ch == 7) censusRowOf<9, 7>(rows, width, cw, ch, out);
+    else censusRowOf<0, 0>(rows, width, cw, ch, out);
 }
 
 // ---- costs ----------------------------------------------------------------------------
