@@ -511,7 +511,9 @@ struct Divider {
     int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
 };
 
-// One pixel's winner takes all, its least sum m already known.
+// One pixel's winner takes all, its least sum m already known. Sentinels: s[-1] and
+// s[numDisp] hold 0xFFFF (never under the threshold), so b - 1 and b + 1 need no bounds.
+template <bool Sentinels = false>
 inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
                      uint16_t *bestSum, uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
@@ -547,8 +549,12 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
     }
     best[x] = static_cast<int16_t>(b);
     // Those at b - 1, b, b + 1 do not count (without a loop: its trip count varies).
-    const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
-    below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    if (Sentinels) {
+        below -= (s[b - 1] < threshold) + (s[b] < threshold) + (s[b + 1] < threshold);
+    } else {
+        const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
+        below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    }
     disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
 }
 
@@ -589,13 +595,15 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     // of dependent steps (least sum, threshold, masks, lowest d, parabola), and the
     // chains of neighbouring pixels, side by side in the instruction stream, overlap.
     constexpr int kBatch = 8;
-    alignas(64) uint16_t local[kBatch][kDispAlign * 8];
+    // Each pixel's sums from [kLanes16]: sentinels 0xFFFF at d = -1 and d = numDisp.
+    alignas(64) uint16_t local[kBatch][kDispAlign * 8 + 2 * kLanes16];
+    for (auto &row : local) row[kLanes16 - 1] = 0xFFFF;
     int leastOf[kBatch];
     for (int x0 = 0; x0 < width; x0 += kBatch) {
         const int n = std::min(kBatch, width - x0);
         for (int j = 0; j < n; ++j) {
             const int x = x0 + j;
-            uint16_t *sums = local[j];
+            uint16_t *sums = local[j] + kLanes16;
             const bool has = prevL != nullptr;
             const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
             const int minPrev = has ? prevMin[x] : 255;
@@ -629,8 +637,10 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             int m = leastWord(leastSum);
             for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
             leastOf[j] = m;
+            sums[w.numDisp] = 0xFFFF;
         }
-        for (int j = 0; j < n; ++j) wtaPixel(local[j], leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
+        for (int j = 0; j < n; ++j)
+            wtaPixel<true>(local[j] + kLanes16, leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
     }
 }
 
