@@ -25,13 +25,15 @@ struct Settings {
     int disp12MaxDiff = 1;      // -1: no left-right check
     bool subpixel = true;
     int medianPx = 5;           // 1: none
-    int stripes = 4;
+    int stripes = 2;
     double maxMemoryBytes = 2048.0 * 1048576.0;
 };
 
 // Rows a stripe runs its vertical paths above (and below) its own rows before they count:
 // stripes are matched independently, in parallel.
 constexpr int kStripeOverlapRows = 16;
+// At most this many bands of rows for the median and the conversion, run in parallel.
+constexpr int kFinishBands = 8;
 
 class Engine {
 public:
@@ -60,7 +62,7 @@ private:
         std::vector<uint16_t> bestSum, rightSum;
     };
     void prepare(int width, int height);
-    void censusImage(const cv::Mat &grey, cv::Mat &padded, std::vector<uint64_t> &census);
+    void census(const cv::Mat &left, const cv::Mat &right);
     void matchStripe(int stripe, int y0, int y1);
     // The costs of row y: computed into the stripe's row (or into the cost volume, for a
     // row of the stripe's own in the pass down), or read back from the volume.
@@ -84,7 +86,8 @@ private:
     bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2Lut_[256];
-    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_, filtered_;
+    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
+    std::vector<cv::Mat> bandOut_; // per band of the median: its filtered rows
     std::vector<uint64_t> censusLeft_, censusRight_;
     std::vector<uint16_t> volume_;  // 8 paths: the pass down's sums
     std::vector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)

@@ -42,25 +42,69 @@ inline v_uint64 popcount64(const v_uint64 &a) {
 #endif
 }
 
-// ---- census ---------------------------------------------------------------------------
+// The least byte of a vector: every path's minimum at every pixel, on the serial chain of
+// the horizontal paths. With AVX2 the pairs of bytes are first folded into 16-bit lanes
+// (shifting a 16-bit lane right by 8 leaves its high byte 0, so the minimum's high byte
+// is 0 too), then SSE4.1's PHMINPOSUW takes the least of eight 16-bit lanes at once: six
+// instructions where v_reduce_min's halvings take ten.
+inline int leastByte(const v_uint8 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFF;
+#else
+    return v_reduce_min(a);
+#endif
+}
+
+// The least 16-bit lane, the same way.
+inline int leastWord(const v_uint16 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    const __m128i v = _mm_min_epu16(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFFFF;
+#else
+    return v_reduce_min(a);
+#endif
+}
+
+// ---- census ----------------------------------------------------------------------------
 // kLanes8 pixels at once: the comparison masks of each neighbour are gathered into eight
 // byte planes (plane b holds bits 8b..8b+7 of every pixel), then interleaved (zip) into
-// one 64-bit word per pixel.
-void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
-    const int rx = cw / 2, ry = ch / 2;
+// one 64-bit word per pixel. A plane is built in a register, its neighbours taken from
+// the highest bit down: doubling it and subtracting the mask (all ones = -1) shifts the
+// next bit in, with no read-modify-write of memory between two neighbours.
+// CW, CH: the window when known at compile time (the default 9 x 7: the loops unroll and
+// every neighbour's row and column become constants), 0 when not.
+template <int CW, int CH>
+void censusRowOf(const uint8_t *const *rows, int width, int runtimeCw, int runtimeCh, uint64_t *out) {
+    const int cw = CW > 0 ? CW : runtimeCw, ch = CH > 0 ? CH : runtimeCh;
+    const int rx = cw / 2, ry = ch / 2, count = cw * ch - 1;
+    // Neighbour k: its row and its column offset, in the order of the bits.
+    const uint8_t *row[64];
+    int offset[64];
+    for (int k = 0; k < count; ++k) {
+        const int n = k < ry * cw + rx ? k : k + 1; // the centre skipped
+        row[k] = rows[n / cw];
+        offset[k] = n % cw - rx;
+    }
     int x = 0;
     for (; x + kLanes8 <= width; x += kLanes8) {
         const v_uint8 centre = vx_load(rows[ry] + x);
         v_uint8 plane[8];
-        for (auto &p : plane) p = vx_setzero_u8();
-        int k = 0;
-        for (int j = 0; j < ch; ++j)
-            for (int dx = -rx; dx <= rx; ++dx) {
-                if (j == ry && dx == 0) continue;
-                const v_uint8 darker = vx_load(rows[j] + x + dx) < centre;
-                plane[k >> 3] = plane[k >> 3] | (darker & vx_setall_u8(static_cast<uint8_t>(1u << (k & 7))));
-                ++k;
+#pragma GCC unroll 8
+        for (int b = 0; b < 8; ++b) {
+            v_uint8 p = vx_setzero_u8();
+#pragma GCC unroll 8
+            for (int i = 7; i >= 0; --i) {
+                const int k = 8 * b + i;
+                if (k >= count) continue;
+                const uint8_t *at = CW > 0 ? rows[(k < ry * cw + rx ? k : k + 1) / cw] +
+                                                 ((k < ry * cw + rx ? k : k + 1) % cw - rx)
+                                           : row[k] + offset[k];
+                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(at + x) < centre));
             }
+            plane[b] = p;
+        }
         // bytes -> 16-bit pairs -> 32-bit quads -> 64-bit words, pixel order kept.
         v_uint8 z[8];
         for (int b = 0; b < 4; ++b) v_zip(plane[2 * b], plane[2 * b + 1], z[2 * b], z[2 * b + 1]);
@@ -89,6 +133,11 @@ void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *
             }
         out[x] = bits;
     }
+}
+
+void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
+    if (cw == 9 && ch == 7) censusRowOf<9, 7>(rows, width, cw, ch, out);
+    else censusRowOf<0, 0>(rows, width, cw, ch, out);
 }
 
 // ---- costs ----------------------------------------------------------------------------
@@ -193,7 +242,7 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
                     least[i] = v_min(least[i], l);
                 }
             }
-            for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+            for (int i = 0; i < n; ++i) paths.curMin[i][x] = leastByte(least[i]);
             continue;
         }
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
@@ -217,7 +266,7 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
             v_store(s0 + d, lo);
             v_store(s0 + d + kLanes16, hi);
         }
-        for (int i = 0; i < n; ++i) paths.curMin[i][x] = v_reduce_min(least[i]);
+        for (int i = 0; i < n; ++i) paths.curMin[i][x] = leastByte(least[i]);
     }
 }
 
@@ -229,15 +278,18 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
     const int stride = pathStride(paddedDisp);
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     const int dx = paths.dx[0];
+    // Local copies: stores through uint8_t pointers may alias the caller's structures.
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     for (int x = 0; x < width; ++x) {
         const int xp = x + dx;
-        const bool has = paths.prevL[0] && xp >= 0 && xp < width;
-        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(xp) * stride + 1 : freshPath();
-        const int minPrev = has ? paths.prevMin[0][xp] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+        const bool has = prevL && xp >= 0 && xp < width;
+        const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
+        const int minPrev = has ? prevMin[xp] : 255;
+        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[xp])] : lut[0];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
-        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
+        uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = vx_setall_u8(255);
 #pragma GCC unroll 8
@@ -248,7 +300,7 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
             v_store(out + d, l);
             least = v_min(least, l);
         }
-        paths.curMin[0][x] = v_reduce_min(least);
+        curMin[x] = leastByte(least);
     }
 }
 
@@ -308,7 +360,7 @@ struct HorizontalChain {
                 v_store(s + kLanes16, vx_load(s + kLanes16) + hi);
             }
         }
-        minPrev = v_reduce_min(least);
+        minPrev = leastByte(least);
         std::swap(prev, cur);
         previousX = x;
     }
@@ -344,7 +396,7 @@ struct RegisterChain {
             cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
             least = v_min(least, cur[c]);
         }
-        minPrev = v_reduce_min(least);
+        minPrev = leastByte(least);
         previousX = x;
 #pragma GCC unroll 8
         for (int c = 0; c < Chunks; ++c) {
@@ -368,15 +420,25 @@ template <int Chunks, int Rows>
 void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
                   const PathParams &pp, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
+    const PathParams params = pp; // a local copy: the sums' stores cannot alias it
+    const uint8_t *rowCost[Rows], *rowGrey[Rows];
+    uint16_t *rowSum[Rows];
+    for (int r = 0; r < Rows; ++r) {
+        rowCost[r] = cost[r];
+        rowGrey[r] = grey[r];
+        rowSum[r] = sum[r];
+    }
     RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
         // Sums are exact (at most 8 x 255), so the order of the additions does not
         // matter; the first path to reach a pixel stores instead of adding.
 #pragma GCC unroll 2
-        for (int r = 0; r < Rows; ++r) forward[r].step(cost[r], paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+        for (int r = 0; r < Rows; ++r)
+            forward[r].step(rowCost[r], paddedDisp, i, rowGrey[r], params, p1, rowSum[r], initSum && i <= xb);
 #pragma GCC unroll 2
-        for (int r = 0; r < Rows; ++r) backward[r].step(cost[r], paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
+        for (int r = 0; r < Rows; ++r)
+            backward[r].step(rowCost[r], paddedDisp, xb, rowGrey[r], params, p1, rowSum[r], initSum && xb > i);
     }
 }
 
@@ -449,7 +511,9 @@ struct Divider {
     int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
 };
 
-// One pixel's winner takes all, its least sum m already known.
+// One pixel's winner takes all, its least sum m already known. Sentinels: s[-1] and
+// s[numDisp] hold 0xFFFF (never under the threshold), so b - 1 and b + 1 need no bounds.
+template <bool Sentinels = false>
 inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
                      uint16_t *bestSum, uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
@@ -484,8 +548,13 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         return;
     }
     best[x] = static_cast<int16_t>(b);
-    // Those at b - 1, b, b + 1 do not count.
-    for (int d = std::max(0, b - 1); d <= std::min(wp.numDisp - 1, b + 1); ++d) below -= s[d] < threshold;
+    // Those at b - 1, b, b + 1 do not count (without a loop: its trip count varies).
+    if (Sentinels) {
+        below -= (s[b - 1] < threshold) + (s[b] < threshold) + (s[b + 1] < threshold);
+    } else {
+        const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
+        below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    }
     disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
 }
 
@@ -497,7 +566,7 @@ void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, 
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
-        int m = v_reduce_min(least);
+        int m = leastWord(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
         wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
     }
@@ -517,41 +586,61 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const int whole = wp.numDisp / kLanes16 * kLanes16;
     const Divider divide(100 - wp.uniquenessPercent);
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    alignas(64) uint16_t local[kDispAlign * 8];
-    for (int x = 0; x < width; ++x) {
-        const bool has = paths.prevL[0] != nullptr;
-        const uint8_t *prev = has ? paths.prevL[0] + static_cast<size_t>(x) * stride + 1 : freshPath();
-        const int minPrev = has ? paths.prevMin[0][x] : 255;
-        const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[x])] : pp.p2Lut[0];
-        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
-        v_uint8 least = vx_setall_u8(255);
-        v_uint16 leastSum = vx_setall_u16(0xFFFF);
-        uint8_t *out = paths.curL[0] + static_cast<size_t>(x) * stride + 1;
-        const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
-        const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
-        const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+    // Local copies: the stores through uint8_t pointers below may alias anything, so the
+    // compiler would otherwise load every field again at each pixel.
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
+    const WtaParams w = wp;
+    // The sums of a batch of pixels first, then their winners: a winner is a long chain
+    // of dependent steps (least sum, threshold, masks, lowest d, parabola), and the
+    // chains of neighbouring pixels, side by side in the instruction stream, overlap.
+    constexpr int kBatch = 8;
+    // Each pixel's sums from [kLanes16]: sentinels 0xFFFF at d = -1 and d = numDisp.
+    alignas(64) uint16_t local[kBatch][kDispAlign * 8 + 2 * kLanes16];
+    for (auto &row : local) row[kLanes16 - 1] = 0xFFFF;
+    int leastOf[kBatch];
+    for (int x0 = 0; x0 < width; x0 += kBatch) {
+        const int n = std::min(kBatch, width - x0);
+        for (int j = 0; j < n; ++j) {
+            const int x = x0 + j;
+            uint16_t *sums = local[j] + kLanes16;
+            const bool has = prevL != nullptr;
+            const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
+            const int minPrev = has ? prevMin[x] : 255;
+            const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
+            const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
+            const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            v_uint8 least = vx_setall_u8(255);
+            v_uint16 leastSum = vx_setall_u16(0xFFFF);
+            uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
+            const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
+            const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
+            const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
 #pragma GCC unroll 8
-        for (int d = 0; d < paddedDisp; d += kLanes8) {
-            const uint8_t *q = prev + d;
-            const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
-            const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
-            v_store(out + d, l);
-            least = v_min(least, l);
-            v_uint16 l0, l1, k0lo, k0hi;
-            v_expand(l, l0, l1);
-            v_expand(vx_load(k0 + d), k0lo, k0hi);
-            const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
-            const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
-            v_store(local + d, lo);
-            v_store(local + d + kLanes16, hi);
-            if (d < whole) leastSum = v_min(leastSum, lo);
-            if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
+            for (int d = 0; d < paddedDisp; d += kLanes8) {
+                const uint8_t *q = prev + d;
+                const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
+                const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
+                v_store(out + d, l);
+                least = v_min(least, l);
+                v_uint16 l0, l1, k0lo, k0hi;
+                v_expand(l, l0, l1);
+                v_expand(vx_load(k0 + d), k0lo, k0hi);
+                const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
+                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
+                v_store(sums + d, lo);
+                v_store(sums + d + kLanes16, hi);
+                if (d < whole) leastSum = v_min(leastSum, lo);
+                if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
+            }
+            curMin[x] = leastByte(least);
+            int m = leastWord(leastSum);
+            for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
+            leastOf[j] = m;
+            sums[w.numDisp] = 0xFFFF;
         }
-        paths.curMin[0][x] = v_reduce_min(least);
-        int m = v_reduce_min(leastSum);
-        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, local[d]);
-        wtaPixel(local, m, x, wp, divide, best, bestSum, disparity16);
+        for (int j = 0; j < n; ++j)
+            wtaPixel<true>(local[j] + kLanes16, leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
     }
 }
 

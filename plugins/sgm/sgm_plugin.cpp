@@ -59,7 +59,7 @@ public:
                 .help("refine each disparity by a parabola through the neighbouring sums (1/16 px)"),
             Param::integer("median_px", "5").min(1).max(5).odd().unit("px")
                 .help("side of the median filter on the disparity; 1 = none"),
-            Param::integer("stripes", "4").min(1).max(64)
+            Param::integer("stripes", "2").min(1).max(64)
                 .help("horizontal stripes matched in parallel (each warms its paths up on 16 rows of the next); the result depends on it, not on the thread count"),
             Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
                 .help("refuse a pair whose working memory (with 4 or 8 paths: width x height x num_disparities x 2 bytes and more) would exceed this"),
