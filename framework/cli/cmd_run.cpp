@@ -76,23 +76,23 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "128 + signal); a second signal ends it at once. The rig's runtime: block sets the\n"
               "policy (README \"Runtime\").\n"
               "Example: binocle run RIG.yaml --frames 10 --set matcher.num_disparities=128 --set transforms.0.inclination_deg=10",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<RunArgs>();
-                  addRigArgs(app, args->rig);
-                  app.add_option("--frames", args->frames, "stop after N frames (default: until the source ends)")
-                      ->type_name("N")
-                      ->check(atLeast(1));
-                  app.add_option("--out", args->out, "output folder (created if needed)")->type_name("DIR");
-                  app.add_flag("--force", args->force,
-                               "replace what --out holds when it is another kind of output (a recording, an experiment)");
-                  app.add_flag("--quiet", args->quiet, "no progress display");
-                  app.add_flag("--mcap", args->mcap,
-                               "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
-                               "in the ground frame, figures (docs/ros2.md)");
-                  app.add_option("--ros-namespace", args->rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
-                      ->type_name("NS");
-                  return [args] { return runRig(*args); };
-              }}};
+              define<RunArgs>(
+                  [](CLI::App &app, RunArgs &args) {
+                      addRigArgs(app, args.rig);
+                      app.add_option("--frames", args.frames, "stop after N frames (default: until the source ends)")
+                          ->type_name("N")
+                          ->check(atLeast(1));
+                      app.add_option("--out", args.out, "output folder (created if needed)")->type_name("DIR");
+                      app.add_flag("--force", args.force,
+                                   "replace what --out holds when it is another kind of output (a recording, an experiment)");
+                      app.add_flag("--quiet", args.quiet, "no progress display");
+                      app.add_flag("--mcap", args.mcap,
+                                   "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
+                                   "in the ground frame, figures (docs/ros2.md)");
+                      app.add_option("--ros-namespace", args.rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
+                          ->type_name("NS");
+                  },
+                  runRig)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace binocle::cli {
@@ -39,7 +40,24 @@ struct Command {
     std::function<Runner(CLI::App &app)> define;
 };
 
-// One static object per command file: `Register reg{{"name", "summary", "details", define}};`
+// The `define` of a command whose work is a plain function of a plain options struct:
+// `options(app, args)` binds the positionals and options to a fresh `Args` (shared with
+// the Runner), and the Runner calls `run(args)`, or `run(args, app)` for a command that
+// asks the parsed app itself (which options were given, its parent).
+template <class Args, class Options, class Run>
+std::function<Runner(CLI::App &app)> define(Options options, Run run) {
+    return [options, run](CLI::App &app) -> Runner {
+        auto args = std::make_shared<Args>();
+        options(app, *args);
+        if constexpr (std::is_invocable_v<Run, Args &, CLI::App &>)
+            return [args, run, &app] { return run(*args, app); };
+        else
+            return [args, run] { return run(*args); };
+    };
+}
+
+// One static object per command file:
+// `Register reg{{"name", "summary", "details", define<NameArgs>(options, run)}};`
 struct Register {
     explicit Register(Command c);
 };
