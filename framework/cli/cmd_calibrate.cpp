@@ -108,7 +108,8 @@ struct CalibrateArgs {
     CalibrationOptions options;
     bool live = false;
     std::optional<long long> pairs_wanted;
-    long long frames = -1, still_frames = 5;
+    int64_t frames = -1;
+    long long still_frames = 5;
     double still_px = 1.0;
 };
 
@@ -292,7 +293,7 @@ Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm
                       app.add_option("--pairs-wanted", a.pairs_wanted, "stop after N good pairs (default 12 with --live, else all frames)")
                           ->type_name("N")
                           ->check(wholeNumber());
-                      app.add_option("--frames", a.frames, "read at most N frames from the source")->type_name("N")->check(atLeast(1));
+                      addFramesOption(app, a.frames, "read at most N frames from the source");
                       app.add_option("--still-frames", a.still_frames, "live: frames the board must be still (default 5)")
                           ->type_name("N")
                           ->check(atLeast(2));

@@ -33,10 +33,8 @@ int record(const RecordArgs &args) {
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRig(args.rig, host);
-    RecordOptions options;
-    options.max_frames = args.frames;
+    RecordOptions options = framesAndProgress<RecordOptions>(args.frames, args.quiet);
     options.grab_timeout_ms = args.timeout_ms;
-    options.progress = !args.quiet;
     // First Ctrl-C (or SIGTERM, SIGHUP): finish the frames being written and stop.
     // Second: die at once (what is written stays readable either way).
     StopSignalGuard signals;
@@ -90,16 +88,13 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
               "each fsync'ed; summary and footer on a clean stop) and DIR/metadata.yaml, for\n"
               "ros2 bag play, Foxglove, and replay (source: {plugin: replay, bag: DIR}).\n"
               "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
-              define<RecordArgs>(
+              defineOnRig<RecordArgs>(
                   [](CLI::App &app, RecordArgs &args) {
-                      addRigArgs(app, args.rig);
                       app.add_option("--out", args.out,
                                      "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
                           ->type_name("DIR")
                           ->required();
-                      app.add_option("--frames", args.frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)")
-                          ->type_name("N")
-                          ->check(atLeast(1));
+                      addFramesOption(app, args.frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)");
                       app.add_option("--timeout-ms", args.timeout_ms, "longest wait for one frame (default 5000)")
                           ->type_name("MS")
                           ->check(atLeast(1));

@@ -73,9 +73,8 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
               "paths it sets stay inside the rig's folders (docs/security.md). Browsers that are\n"
               "slow get fewer frames; the pipeline never waits for them. Ctrl-C stops.\n"
               "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
-              define<ViewArgs>(
+              defineOnRig<ViewArgs>(
                   [](CLI::App &app, ViewArgs &args) {
-                      addRigArgs(app, args.rig);
                       app.add_option("--port", args.options.port, "TCP port (0: any free port)")
                           ->type_name("N")
                           ->check(wholeNumberIn(0, 65535))
@@ -103,7 +102,7 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                           ->type_name("F")
                           ->check(positiveNumber())
                           ->capture_default_str();
-                      app.add_option("--frames", args.frames, "stop after N frames (measurements)")->type_name("N")->check(atLeast(1));
+                      addFramesOption(app, args.frames, "stop after N frames (measurements)");
                       app.add_flag("--paused", args.options.paused, "start paused on the first frame");
                   },
                   view)}};

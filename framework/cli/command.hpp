@@ -75,6 +75,28 @@ struct RigArgs {
 };
 // RIG (positional; required unless `required` is false) and --set KEY=VALUE (repeatable).
 void addRigArgs(CLI::App &app, RigArgs &args, bool required = true);
+
+// The `define` of a command on a rig: RIG and --set into `args.rig` first, then `options`.
+template <class Args, class Options, class Run>
+std::function<Runner(CLI::App &app)> defineOnRig(Options options, Run run) {
+    return define<Args>(
+        [options](CLI::App &app, Args &args) {
+            addRigArgs(app, args.rig);
+            options(app, args);
+        },
+        run);
+}
+
+// --frames N: stop after N frames, a whole number >= 1 (`help` says of what and the default).
+CLI::Option *addFramesOption(CLI::App &app, int64_t &frames, const std::string &help);
+// The pipeline's options (RunOptions, RecordOptions) with --frames and --quiet applied:
+// at most `frames` frames (< 0: until the source ends), a progress display unless quiet.
+template <class Options> Options framesAndProgress(int64_t frames, bool quiet) {
+    Options options;
+    options.max_frames = frames;
+    options.progress = !quiet;
+    return options;
+}
 // The rig with every --set override applied, validated against the plugins `host` found.
 RigConfig loadRig(const RigArgs &args, const PluginHost &host);
 
