@@ -75,6 +75,8 @@ struct RigArgs {
 };
 // RIG (positional; required unless `required` is false) and --set KEY=VALUE (repeatable).
 void addRigArgs(CLI::App &app, RigArgs &args, bool required = true);
+// The rig with every --set override applied, validated against the plugins `host` found.
+RigConfig loadRig(const RigArgs &args, const PluginHost &host);
 
 // The `define` of a command on a rig: RIG and --set into `args.rig` first, then `options`.
 template <class Args, class Options, class Run>
@@ -97,8 +99,6 @@ template <class Options> Options framesAndProgress(int64_t frames, bool quiet) {
     options.progress = !quiet;
     return options;
 }
-// The rig with every --set override applied, validated against the plugins `host` found.
-RigConfig loadRig(const RigArgs &args, const PluginHost &host);
 
 // Validators with messages in the words of the other errors. Every numeric option takes
 // one of these, before any other check: they read the text with the one number reader
