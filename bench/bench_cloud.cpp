@@ -5,6 +5,7 @@
 //   build/bench/binocle_bench --benchmark_filter=CloudStage
 #include "core/calibration.hpp"
 #include "core/cloud.hpp"
+#include "reference_cloud.hpp"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
@@ -46,15 +47,10 @@ void BM_CloudStageVersusReproject(benchmark::State &state) {
         cv::reprojectImageTo3D(disparity, xyz, cal.Q, true);
         kept.clear();
         pixels.clear();
-        for (int v = 0; v < xyz.rows; ++v) {
-            const float *d = disparity.ptr<float>(v);
-            const cv::Vec3f *p = xyz.ptr<cv::Vec3f>(v);
-            for (int u = 0; u < xyz.cols; ++u) {
-                if (!(d[u] > 0) || !(p[u][2] > 0) || p[u][2] > maxRange) continue;
-                kept.emplace_back(p[u][0], p[u][1], p[u][2]);
-                pixels.push_back(v * xyz.cols + u);
-            }
-        }
+        binocle::bench::forEachValidPoint(disparity, xyz, maxRange, [&](int u, int v, const cv::Vec3f &p) {
+            kept.emplace_back(p[0], p[1], p[2]);
+            pixels.push_back(v * xyz.cols + u);
+        });
         const double a = since(t0);
         t0 = Clock::now();
         projector.project(disparity, l, cloud); // with the colours, as the pipeline does

@@ -13,6 +13,7 @@
 #include "core/calibration.hpp"
 #include "method/density_grid.hpp"
 #include "pipeline/pipeline.hpp"
+#include "reference_cloud.hpp"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
@@ -145,18 +146,13 @@ public:
         steps[3] += since(t0);
         t0 = Clock::now();
         points_.clear();
-        for (int v = 0; v < xyz_.rows; ++v) {
-            const float *d = disparity_.ptr<float>(v);
-            const cv::Vec3f *q = xyz_.ptr<cv::Vec3f>(v);
-            for (int u = 0; u < xyz_.cols; ++u) {
-                if (!(d[u] > 0) || !(q[u][2] > 0) || q[u][2] > kMaxRangeMm) continue;
-                const cv::Vec3d c = R1t_ * cv::Vec3d(q[u][0], q[u][1], q[u][2]);
-                // Eq. 1
-                points_.push_back(static_cast<float>(c[0]));
-                points_.push_back(static_cast<float>(c[2] * cos_ - c[1] * sin_));
-                points_.push_back(static_cast<float>(kCameraHeightMm - c[2] * sin_ - c[1] * cos_));
-            }
-        }
+        binocle::bench::forEachValidPoint(disparity_, xyz_, kMaxRangeMm, [&](int, int, const cv::Vec3f &q) {
+            const cv::Vec3d c = R1t_ * cv::Vec3d(q[0], q[1], q[2]);
+            // Eq. 1
+            points_.push_back(static_cast<float>(c[0]));
+            points_.push_back(static_cast<float>(c[2] * cos_ - c[1] * sin_));
+            points_.push_back(static_cast<float>(kCameraHeightMm - c[2] * sin_ - c[1] * cos_));
+        });
         steps[4] += since(t0);
         t0 = Clock::now();
         const binocle::method::DensityGrids g = binocle::method::binCloud(binocle::method::CloudView(points_), spec_);

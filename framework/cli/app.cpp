@@ -71,6 +71,10 @@ void addRigArgs(CLI::App &app, RigArgs &args, bool required) {
         ->allow_extra_args(false);
 }
 
+CLI::Option *addFramesOption(CLI::App &app, int64_t &frames, const std::string &help) {
+    return app.add_option("--frames", frames, help)->type_name("N")->check(atLeast(1));
+}
+
 RigConfig loadRig(const RigArgs &args, const PluginHost &host) {
     try {
         std::vector<Override> overrides;

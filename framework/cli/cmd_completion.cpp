@@ -80,14 +80,14 @@ std::string bashScript(const CLI::App &root) {
 Register reg{{"completion", "print a shell completion script (bash) made from these definitions",
               "Example: source <(binocle completion bash)\n"
               "Installed packages ship it as share/bash-completion/completions/binocle.",
-              [](CLI::App &app) -> Runner {
-                  auto shell = std::make_shared<std::string>();
-                  app.add_option("shell", *shell, "the shell")->required()->check(CLI::IsMember({"bash"}));
-                  return [shell, &app] {
+              define<std::string>(
+                  [](CLI::App &app, std::string &shell) {
+                      app.add_option("shell", shell, "the shell")->required()->check(CLI::IsMember({"bash"}));
+                  },
+                  [](const std::string &, const CLI::App &app) {
                       std::cout << bashScript(*app.get_parent());
                       return 0;
-                  };
-              }}};
+                  })}};
 
 } // namespace
 } // namespace binocle::cli

@@ -71,11 +71,11 @@ Register reg{{"devices", "list the devices each source plugin can see (cameras, 
               "A plugin that fails is listed with `error:` and the others are still asked;\n"
               "the exit status is then 1. Plugins that talk to networks (gige) send discovery\n"
               "broadcasts on every interface.",
-              [](CLI::App &app) -> Runner {
-                  auto plugin = std::make_shared<std::string>();
-                  app.add_option("--plugin", *plugin, "ask this source plugin only")->type_name("NAME");
-                  return [plugin] { return listDevices(*plugin); };
-              }}};
+              define<std::string>(
+                  [](CLI::App &app, std::string &plugin) {
+                      app.add_option("--plugin", plugin, "ask this source plugin only")->type_name("NAME");
+                  },
+                  listDevices)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -84,34 +84,34 @@ Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of
               "error bars. calibration: board calibrates every configuration from chessboard pairs\n"
               "first. results.json holds Spearman's rho of each predictor against η3D.\n"
               "`binocle experiment merge OUT DIR...` joins the folders of --shard runs.",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<ExperimentArgs>();
-                  app.add_option("file", args->file, "the experiment file (YAML)")->type_name("FILE");
-                  app.add_option("--set", args->set,
-                                 "change a key of the experiment file (repeats=10, calibration=board, "
-                                 "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640); repeatable")
-                      ->type_name("KEY=VALUE")
-                      ->allow_extra_args(false);
-                  app.add_option("--shard", args->shard,
-                                 "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
-                                 "shards with `binocle experiment merge OUT DIR...`")
-                      ->type_name("K/N")
-                      ->check(wholeNumbers('/', 1));
-                  auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
-                                                        "one unsharded run (timings apart)");
-                  m->add_option("folders", args->merge, "OUT DIR...")->required()->expected(2, -1);
-                  app.add_option("--out", args->out, "output folder (default out/<experiment name>)")->type_name("DIR");
-                  app.add_option("--tests", args->tests, "run only these tests, e.g. --tests 1,5,9")
-                      ->type_name("ID,ID...")
-                      ->delimiter(',')
-                      ->allow_extra_args(false);
-                  app.add_flag("--check", args->check, "validate the file and stop");
-                  app.add_flag("--force", args->force, "replace the results of another experiment in the output folder");
-                  m->add_flag("--force", args->force, "replace the results already in OUT");
-                  app.add_flag("--quiet", args->quiet, "no progress display");
-                  app.add_flag("--report", args->report, "also write DIR/report.html (as `binocle report DIR`)");
-                  return [args] { return experiment(*args); };
-              }}};
+              define<ExperimentArgs>(
+                  [](CLI::App &app, ExperimentArgs &args) {
+                      app.add_option("file", args.file, "the experiment file (YAML)")->type_name("FILE");
+                      app.add_option("--set", args.set,
+                                     "change a key of the experiment file (repeats=10, calibration=board, "
+                                     "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640); repeatable")
+                          ->type_name("KEY=VALUE")
+                          ->allow_extra_args(false);
+                      app.add_option("--shard", args.shard,
+                                     "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
+                                     "shards with `binocle experiment merge OUT DIR...`")
+                          ->type_name("K/N")
+                          ->check(wholeNumbers('/', 1));
+                      auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
+                                                            "one unsharded run (timings apart)");
+                      m->add_option("folders", args.merge, "OUT DIR...")->required()->expected(2, -1);
+                      app.add_option("--out", args.out, "output folder (default out/<experiment name>)")->type_name("DIR");
+                      app.add_option("--tests", args.tests, "run only these tests, e.g. --tests 1,5,9")
+                          ->type_name("ID,ID...")
+                          ->delimiter(',')
+                          ->allow_extra_args(false);
+                      app.add_flag("--check", args.check, "validate the file and stop");
+                      app.add_flag("--force", args.force, "replace the results of another experiment in the output folder");
+                      m->add_flag("--force", args.force, "replace the results already in OUT");
+                      app.add_flag("--quiet", args.quiet, "no progress display");
+                      app.add_flag("--report", args.report, "also write DIR/report.html (as `binocle report DIR`)");
+                  },
+                  experiment)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -50,18 +50,18 @@ Register reg{{"plugin-check", "check a plugin against the ABI's rules (conforman
               "saying why; skipped cases are counted apart and never read as a pass.\n"
               "Exit status 0 when no case failed, 1 otherwise, 2 for a --set the plugin\n"
               "refuses (an unknown key or a bad value).",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<PluginCheckArgs>();
-                  app.add_option("plugin", args->options.plugin, "the plugin file (FILE.so) or name (binocle_NAME.so in the search path)")
-                      ->required()
-                      ->type_name("FILE.so|NAME");
-                  app.add_option("--set", args->options.settings, "a setting given to create (repeatable), e.g. --set window_px=7")
-                      ->type_name("KEY=VALUE")
-                      ->allow_extra_args(false);
-                  app.add_option("--junit", args->junit, "write a JUnit XML report for CI")->type_name("FILE");
-                  app.add_option("--timeout-ms", args->timeout_ms, "a case running longer fails (default 20000)")->check(atLeast(100));
-                  return [args] { return checkPluginCommand(*args); };
-              }}};
+              define<PluginCheckArgs>(
+                  [](CLI::App &app, PluginCheckArgs &args) {
+                      app.add_option("plugin", args.options.plugin, "the plugin file (FILE.so) or name (binocle_NAME.so in the search path)")
+                          ->required()
+                          ->type_name("FILE.so|NAME");
+                      app.add_option("--set", args.options.settings, "a setting given to create (repeatable), e.g. --set window_px=7")
+                          ->type_name("KEY=VALUE")
+                          ->allow_extra_args(false);
+                      app.add_option("--junit", args.junit, "write a JUnit XML report for CI")->type_name("FILE");
+                      app.add_option("--timeout-ms", args.timeout_ms, "a case running longer fails (default 20000)")->check(atLeast(100));
+                  },
+                  checkPluginCommand)}};
 
 } // namespace
 } // namespace binocle::cli

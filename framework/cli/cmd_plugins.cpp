@@ -67,18 +67,18 @@ Register reg{{"plugins", "list the plugins found, with versions, and those refus
               "every file or folder that was refused with the reason. Each file is first opened\n"
               "in a short-lived child process: one that crashes or hangs while loading is\n"
               "refused with the signal or the timeout.",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<PluginsArgs>();
-                  app.add_flag("--verbose", args->verbose,
-                               "also show each plugin's file and settings (YAML keys) with type, choices, odd, "
-                               "min/max, multiple-of and required");
-                  app.add_option("--load", args->load, "load this plugin file as well (repeatable)")
-                      ->type_name("FILE")
-                      ->allow_extra_args(false);
-                  app.add_option("--timeout-ms", args->timeout_ms, "how long a file may take to load (default 5000)")
-                      ->check(atLeast(100));
-                  return [args] { return listPlugins(*args); };
-              }}};
+              define<PluginsArgs>(
+                  [](CLI::App &app, PluginsArgs &args) {
+                      app.add_flag("--verbose", args.verbose,
+                                   "also show each plugin's file and settings (YAML keys) with type, choices, odd, "
+                                   "min/max, multiple-of and required");
+                      app.add_option("--load", args.load, "load this plugin file as well (repeatable)")
+                          ->type_name("FILE")
+                          ->allow_extra_args(false);
+                      app.add_option("--timeout-ms", args.timeout_ms, "how long a file may take to load (default 5000)")
+                          ->check(atLeast(100));
+                  },
+                  listPlugins)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -33,10 +33,8 @@ int record(const RecordArgs &args) {
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRig(args.rig, host);
-    RecordOptions options;
-    options.max_frames = args.frames;
+    RecordOptions options = framesAndProgress<RecordOptions>(args.frames, args.quiet);
     options.grab_timeout_ms = args.timeout_ms;
-    options.progress = !args.quiet;
     // First Ctrl-C (or SIGTERM, SIGHUP): finish the frames being written and stop.
     // Second: die at once (what is written stays readable either way).
     StopSignalGuard signals;
@@ -90,50 +88,47 @@ Register reg{{"record", "record a rig's source (any plugin) to a folder that rep
               "each fsync'ed; summary and footer on a clean stop) and DIR/metadata.yaml, for\n"
               "ros2 bag play, Foxglove, and replay (source: {plugin: replay, bag: DIR}).\n"
               "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<RecordArgs>();
-                  addRigArgs(app, args->rig);
-                  app.add_option("--out", args->out,
-                                 "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
-                      ->type_name("DIR")
-                      ->required();
-                  app.add_option("--frames", args->frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)")
-                      ->type_name("N")
-                      ->check(atLeast(1));
-                  app.add_option("--timeout-ms", args->timeout_ms, "longest wait for one frame (default 5000)")
-                      ->type_name("MS")
-                      ->check(atLeast(1));
-                  app.add_option("--png-compression", args->png_compression,
-                                 "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
-                      ->type_name("L")
-                      ->check(wholeNumber())
-                      ->check(CLI::Range(0, 9));
-                  app.add_option("--writer-threads", args->writer_threads,
-                                 "threads that encode and write images (default: two per core, 4..16)")
-                      ->type_name("N")
-                      ->check(atLeast(1));
-                  app.add_option("--when-behind", args->when_behind,
-                                 "when the writers fall behind: make the source wait, or drop the pair and count it "
-                                 "(default: drop for a live source such as cameras, wait for files and simulations)")
-                      ->type_name("wait|drop")
-                      ->check(CLI::IsMember({"wait", "drop"}));
-                  app.add_option("--format", args->format,
-                                 "folder (PNG + frames.csv, the default) or mcap (a rosbag2 bag: docs/ros2.md)")
-                      ->type_name("folder|mcap")
-                      ->check(CLI::IsMember({"folder", "mcap"}));
-                  app.add_option("--ros-namespace", args->rosbag.ros_namespace,
-                                 "mcap: the topics' namespace (default /binocle: /binocle/left/image_raw ...)")
-                      ->type_name("NS");
-                  app.add_option("--frame-id-left", args->rosbag.frame_id_left,
-                                 "mcap: header.frame_id of the left images (default binocle_left_optical)")
-                      ->type_name("ID");
-                  app.add_option("--frame-id-right", args->rosbag.frame_id_right,
-                                 "mcap: header.frame_id of the right images (default binocle_right_optical)")
-                      ->type_name("ID");
-                  app.add_flag("--statistics", args->statistics, "print the source's statistics (YAML) at the end");
-                  app.add_flag("--quiet", args->quiet, "no progress display");
-                  return [args] { return record(*args); };
-              }}};
+              defineOnRig<RecordArgs>(
+                  [](CLI::App &app, RecordArgs &args) {
+                      app.add_option("--out", args.out,
+                                     "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
+                          ->type_name("DIR")
+                          ->required();
+                      addFramesOption(app, args.frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)");
+                      app.add_option("--timeout-ms", args.timeout_ms, "longest wait for one frame (default 5000)")
+                          ->type_name("MS")
+                          ->check(atLeast(1));
+                      app.add_option("--png-compression", args.png_compression,
+                                     "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
+                          ->type_name("L")
+                          ->check(wholeNumber())
+                          ->check(CLI::Range(0, 9));
+                      app.add_option("--writer-threads", args.writer_threads,
+                                     "threads that encode and write images (default: two per core, 4..16)")
+                          ->type_name("N")
+                          ->check(atLeast(1));
+                      app.add_option("--when-behind", args.when_behind,
+                                     "when the writers fall behind: make the source wait, or drop the pair and count it "
+                                     "(default: drop for a live source such as cameras, wait for files and simulations)")
+                          ->type_name("wait|drop")
+                          ->check(CLI::IsMember({"wait", "drop"}));
+                      app.add_option("--format", args.format,
+                                     "folder (PNG + frames.csv, the default) or mcap (a rosbag2 bag: docs/ros2.md)")
+                          ->type_name("folder|mcap")
+                          ->check(CLI::IsMember({"folder", "mcap"}));
+                      app.add_option("--ros-namespace", args.rosbag.ros_namespace,
+                                     "mcap: the topics' namespace (default /binocle: /binocle/left/image_raw ...)")
+                          ->type_name("NS");
+                      app.add_option("--frame-id-left", args.rosbag.frame_id_left,
+                                     "mcap: header.frame_id of the left images (default binocle_left_optical)")
+                          ->type_name("ID");
+                      app.add_option("--frame-id-right", args.rosbag.frame_id_right,
+                                     "mcap: header.frame_id of the right images (default binocle_right_optical)")
+                          ->type_name("ID");
+                      app.add_flag("--statistics", args.statistics, "print the source's statistics (YAML) at the end");
+                      app.add_flag("--quiet", args.quiet, "no progress display");
+                  },
+                  record)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -36,13 +36,13 @@ Register reg{{"report", "an experiment's results as one self-contained HTML file
               "(`paper:` per test), the rig and the software versions. Images are inlined: the\n"
               "file opens from disk with no server and no network. When DIR holds several\n"
               "experiment folders (e.g. out/demo), each gets its own report.",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<ReportArgs>();
-                  app.add_option("dir", args->dir, "the experiment's output folder")->type_name("DIR")->required();
-                  app.add_option("--output", args->output, "where to write (one experiment only; default DIR/report.html; a folder: report.html in it)")
-                      ->type_name("FILE");
-                  return [args] { return report(*args); };
-              }}};
+              define<ReportArgs>(
+                  [](CLI::App &app, ReportArgs &args) {
+                      app.add_option("dir", args.dir, "the experiment's output folder")->type_name("DIR")->required();
+                      app.add_option("--output", args.output, "where to write (one experiment only; default DIR/report.html; a folder: report.html in it)")
+                          ->type_name("FILE");
+                  },
+                  report)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -32,10 +32,8 @@ int runRig(const RunArgs &args) {
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
     RigConfig rig = loadRig(args.rig, host);
-    RunOptions options;
-    options.max_frames = args.frames;
+    RunOptions options = framesAndProgress<RunOptions>(args.frames, args.quiet);
     options.out_dir = args.out;
-    options.progress = !args.quiet;
     Pipeline pipeline(rig, host);
     // Owned until the summary is written: a second run into the same folder is refused,
     // and so is a folder that holds a recording or an experiment (unless --force).
@@ -76,23 +74,20 @@ Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluat
               "128 + signal); a second signal ends it at once. The rig's runtime: block sets the\n"
               "policy (README \"Runtime\").\n"
               "Example: binocle run RIG.yaml --frames 10 --set matcher.num_disparities=128 --set transforms.0.inclination_deg=10",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<RunArgs>();
-                  addRigArgs(app, args->rig);
-                  app.add_option("--frames", args->frames, "stop after N frames (default: until the source ends)")
-                      ->type_name("N")
-                      ->check(atLeast(1));
-                  app.add_option("--out", args->out, "output folder (created if needed)")->type_name("DIR");
-                  app.add_flag("--force", args->force,
-                               "replace what --out holds when it is another kind of output (a recording, an experiment)");
-                  app.add_flag("--quiet", args->quiet, "no progress display");
-                  app.add_flag("--mcap", args->mcap,
-                               "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
-                               "in the ground frame, figures (docs/ros2.md)");
-                  app.add_option("--ros-namespace", args->rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
-                      ->type_name("NS");
-                  return [args] { return runRig(*args); };
-              }}};
+              defineOnRig<RunArgs>(
+                  [](CLI::App &app, RunArgs &args) {
+                      addFramesOption(app, args.frames, "stop after N frames (default: until the source ends)");
+                      app.add_option("--out", args.out, "output folder (created if needed)")->type_name("DIR");
+                      app.add_flag("--force", args.force,
+                                   "replace what --out holds when it is another kind of output (a recording, an experiment)");
+                      app.add_flag("--quiet", args.quiet, "no progress display");
+                      app.add_flag("--mcap", args.mcap,
+                                   "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
+                                   "in the ground frame, figures (docs/ros2.md)");
+                      app.add_option("--ros-namespace", args.rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
+                          ->type_name("NS");
+                  },
+                  runRig)}};
 
 } // namespace
 } // namespace binocle::cli

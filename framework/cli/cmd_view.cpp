@@ -73,40 +73,39 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
               "paths it sets stay inside the rig's folders (docs/security.md). Browsers that are\n"
               "slow get fewer frames; the pipeline never waits for them. Ctrl-C stops.\n"
               "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
-              [](CLI::App &app) -> Runner {
-                  auto args = std::make_shared<ViewArgs>();
-                  addRigArgs(app, args->rig);
-                  app.add_option("--port", args->options.port, "TCP port (0: any free port)")
-                      ->type_name("N")
-                      ->check(wholeNumberIn(0, 65535))
-                      ->capture_default_str();
-                  app.add_option("--bind", args->options.address, "address to listen on (an IP address)")
-                      ->type_name("ADDR")
-                      ->capture_default_str();
-                  app.add_flag("--allow-remote", args->options.allow_remote,
-                               "serve a --bind address other than loopback (the token then crosses the network in clear)");
-                  app.add_option("--allow-host", args->options.allowed_hosts,
-                                 "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
-                      ->type_name("NAME");
-                  app.add_option("--out", args->options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
-                  app.add_option("--display-fps", args->options.display_fps,
-                                 "most frames per second sent to browsers (each gets no more than it can draw)")
-                      ->type_name("F")
-                      ->check(positiveNumber())
-                      ->capture_default_str();
-                  app.add_option("--cloud-points", args->options.cloud_points, "most points drawn in the 3D view (thinned evenly)")
-                      ->type_name("N")
-                      ->check(atLeast(1))
-                      ->capture_default_str();
-                  app.add_option("--cloud-fps", args->options.cloud_fps,
-                                 "most new clouds per second for the 3D view (the images come at --display-fps)")
-                      ->type_name("F")
-                      ->check(positiveNumber())
-                      ->capture_default_str();
-                  app.add_option("--frames", args->frames, "stop after N frames (measurements)")->type_name("N")->check(atLeast(1));
-                  app.add_flag("--paused", args->options.paused, "start paused on the first frame");
-                  return [args] { return view(*args); };
-              }}};
+              defineOnRig<ViewArgs>(
+                  [](CLI::App &app, ViewArgs &args) {
+                      app.add_option("--port", args.options.port, "TCP port (0: any free port)")
+                          ->type_name("N")
+                          ->check(wholeNumberIn(0, 65535))
+                          ->capture_default_str();
+                      app.add_option("--bind", args.options.address, "address to listen on (an IP address)")
+                          ->type_name("ADDR")
+                          ->capture_default_str();
+                      app.add_flag("--allow-remote", args.options.allow_remote,
+                                   "serve a --bind address other than loopback (the token then crosses the network in clear)");
+                      app.add_option("--allow-host", args.options.allowed_hosts,
+                                     "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
+                          ->type_name("NAME");
+                      app.add_option("--out", args.options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
+                      app.add_option("--display-fps", args.options.display_fps,
+                                     "most frames per second sent to browsers (each gets no more than it can draw)")
+                          ->type_name("F")
+                          ->check(positiveNumber())
+                          ->capture_default_str();
+                      app.add_option("--cloud-points", args.options.cloud_points, "most points drawn in the 3D view (thinned evenly)")
+                          ->type_name("N")
+                          ->check(atLeast(1))
+                          ->capture_default_str();
+                      app.add_option("--cloud-fps", args.options.cloud_fps,
+                                     "most new clouds per second for the 3D view (the images come at --display-fps)")
+                          ->type_name("F")
+                          ->check(positiveNumber())
+                          ->capture_default_str();
+                      addFramesOption(app, args.frames, "stop after N frames (measurements)");
+                      app.add_flag("--paused", args.options.paused, "start paused on the first frame");
+                  },
+                  view)}};
 
 } // namespace
 } // namespace binocle::cli

@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace binocle::cli {
@@ -39,7 +40,24 @@ struct Command {
     std::function<Runner(CLI::App &app)> define;
 };
 
-// One static object per command file: `Register reg{{"name", "summary", "details", define}};`
+// The `define` of a command whose work is a plain function of a plain options struct:
+// `options(app, args)` binds the positionals and options to a fresh `Args` (shared with
+// the Runner), and the Runner calls `run(args)`, or `run(args, app)` for a command that
+// asks the parsed app itself (which options were given, its parent).
+template <class Args, class Options, class Run>
+std::function<Runner(CLI::App &app)> define(Options options, Run run) {
+    return [options, run](CLI::App &app) -> Runner {
+        auto args = std::make_shared<Args>();
+        options(app, *args);
+        if constexpr (std::is_invocable_v<Run, Args &, CLI::App &>)
+            return [args, run, &app] { return run(*args, app); };
+        else
+            return [args, run] { return run(*args); };
+    };
+}
+
+// One static object per command file:
+// `Register reg{{"name", "summary", "details", define<NameArgs>(options, run)}};`
 struct Register {
     explicit Register(Command c);
 };
@@ -59,6 +77,28 @@ struct RigArgs {
 void addRigArgs(CLI::App &app, RigArgs &args, bool required = true);
 // The rig with every --set override applied, validated against the plugins `host` found.
 RigConfig loadRig(const RigArgs &args, const PluginHost &host);
+
+// The `define` of a command on a rig: RIG and --set into `args.rig` first, then `options`.
+template <class Args, class Options, class Run>
+std::function<Runner(CLI::App &app)> defineOnRig(Options options, Run run) {
+    return define<Args>(
+        [options](CLI::App &app, Args &args) {
+            addRigArgs(app, args.rig);
+            options(app, args);
+        },
+        run);
+}
+
+// --frames N: stop after N frames, a whole number >= 1 (`help` says of what and the default).
+CLI::Option *addFramesOption(CLI::App &app, int64_t &frames, const std::string &help);
+// The pipeline's options (RunOptions, RecordOptions) with --frames and --quiet applied:
+// at most `frames` frames (< 0: until the source ends), a progress display unless quiet.
+template <class Options> Options framesAndProgress(int64_t frames, bool quiet) {
+    Options options;
+    options.max_frames = frames;
+    options.progress = !quiet;
+    return options;
+}
 
 // Validators with messages in the words of the other errors. Every numeric option takes
 // one of these, before any other check: they read the text with the one number reader

@@ -77,23 +77,24 @@ void GridSpec::validate() const {
         throw std::invalid_argument("ground band " + number(ground_band_mm) + " mm: expected a finite number");
 }
 
-const char *viewName(View view) {
+namespace {
+// Each view's name and the two axes of the ground frame it shows.
+struct ViewLabels {
+    const char *name, *axes;
+};
+ViewLabels viewLabels(View view) {
     switch (view) {
-    case View::Top: return "top";
-    case View::Front: return "front";
-    case View::Side: return "side";
+    case View::Top: return {"top", "XY"};
+    case View::Front: return {"front", "XZ"};
+    case View::Side: return {"side", "YZ"};
     }
-    return "?";
+    return {"?", "?"};
 }
+} // namespace
 
-const char *viewAxes(View view) {
-    switch (view) {
-    case View::Top: return "XY";
-    case View::Front: return "XZ";
-    case View::Side: return "YZ";
-    }
-    return "?";
-}
+const char *viewName(View view) { return viewLabels(view).name; }
+
+const char *viewAxes(View view) { return viewLabels(view).axes; }
 
 int DensityView::colOf(double u_mm) const {
     if (!u.contains(u_mm)) return -1;

@@ -181,7 +181,7 @@ void legend(Canvas &c, const std::vector<std::string> &series, double x, double 
     }
 }
 
-void drawBars(Canvas &c, const BarChart &ch, int w, int h) {
+void draw(Canvas &c, const BarChart &ch, int w, int h) {
     const double legendWidth = ch.series.empty() ? 0 : 150;
     const Plot p{70, 50, w - 20 - legendWidth, h - 70.0};
     c.text(w / 2.0, 30, ch.title, 18, kAxis, Anchor::Middle);
@@ -238,7 +238,7 @@ void drawBars(Canvas &c, const BarChart &ch, int w, int h) {
     }
 }
 
-void drawScatter(Canvas &c, const ScatterChart &ch, int w, int h) {
+void draw(Canvas &c, const ScatterChart &ch, int w, int h) {
     double xmin = ch.x_min, xmax = ch.x_max, ymin = ch.y_min, ymax = ch.y_max;
     if (xmax <= xmin) {
         xmin = 0;
@@ -276,40 +276,32 @@ void drawScatter(Canvas &c, const ScatterChart &ch, int w, int h) {
     if (ch.series.size() > 1) legend(c, ch.series, p.right + 20, p.top + 10);
 }
 
+// Either kind of chart, drawn on either canvas.
+template <class Chart> std::string svgOf(const Chart &chart, int width, int height) {
+    SvgCanvas c(width, height);
+    draw(c, chart, width, height);
+    return c.finish();
+}
+
+template <class Chart> cv::Mat imageOf(const Chart &chart, int width, int height) {
+    MatCanvas c(width, height);
+    draw(c, chart, width, height);
+    return c.image();
+}
+
+// STEM.png and STEM.svg, each at its kind's default size.
+template <class Chart> void writeBoth(const std::string &stem, const Chart &chart) {
+    writeImage(stem + ".png", toImage(chart));
+    writeFileAtomic(stem + ".svg", toSvg(chart));
+}
+
 } // namespace
 
-std::string toSvg(const BarChart &chart, int width, int height) {
-    SvgCanvas c(width, height);
-    drawBars(c, chart, width, height);
-    return c.finish();
-}
-
-cv::Mat toImage(const BarChart &chart, int width, int height) {
-    MatCanvas c(width, height);
-    drawBars(c, chart, width, height);
-    return c.image();
-}
-
-std::string toSvg(const ScatterChart &chart, int width, int height) {
-    SvgCanvas c(width, height);
-    drawScatter(c, chart, width, height);
-    return c.finish();
-}
-
-cv::Mat toImage(const ScatterChart &chart, int width, int height) {
-    MatCanvas c(width, height);
-    drawScatter(c, chart, width, height);
-    return c.image();
-}
-
-void writeChart(const std::string &stem, const BarChart &chart) {
-    writeImage(stem + ".png", toImage(chart));
-    writeFileAtomic(stem + ".svg", toSvg(chart));
-}
-
-void writeChart(const std::string &stem, const ScatterChart &chart) {
-    writeImage(stem + ".png", toImage(chart));
-    writeFileAtomic(stem + ".svg", toSvg(chart));
-}
+std::string toSvg(const BarChart &chart, int width, int height) { return svgOf(chart, width, height); }
+cv::Mat toImage(const BarChart &chart, int width, int height) { return imageOf(chart, width, height); }
+std::string toSvg(const ScatterChart &chart, int width, int height) { return svgOf(chart, width, height); }
+cv::Mat toImage(const ScatterChart &chart, int width, int height) { return imageOf(chart, width, height); }
+void writeChart(const std::string &stem, const BarChart &chart) { writeBoth(stem, chart); }
+void writeChart(const std::string &stem, const ScatterChart &chart) { writeBoth(stem, chart); }
 
 } // namespace binocle

@@ -222,10 +222,19 @@ void put(CdrWriter &w, const RegionOfInterest &r) {
     w.u32(r.width);
     w.u8(r.do_rectify ? 1 : 0);
 }
-void put(CdrWriter &w, const Image &m) {
+// The header, height and width that Image, CameraInfo and PointCloud2 begin with.
+template <class Message> void putSized(CdrWriter &w, const Message &m) {
     put(w, m.header);
     w.u32(m.height);
     w.u32(m.width);
+}
+// A sequence: its count, then `put` writes each element.
+template <class T, class Put> void putSequence(CdrWriter &w, const std::vector<T> &v, Put put) {
+    w.u32(static_cast<uint32_t>(v.size()));
+    for (const T &e : v) put(e);
+}
+void put(CdrWriter &w, const Image &m) {
+    putSized(w, m);
     w.str(m.encoding);
     w.u8(m.is_bigendian);
     w.u32(m.step);
@@ -247,11 +256,21 @@ RegionOfInterest getRoi(CdrReader &r) {
     o.do_rectify = r.u8("roi.do_rectify") != 0;
     return o;
 }
-Image getImage(CdrReader &r) {
-    Image m;
+template <class Message> void getSized(CdrReader &r, Message &m) {
     m.header = getHeader(r);
     m.height = r.u32("height");
     m.width = r.u32("width");
+}
+// A sequence: its count (each element takes at least `minElementBytes`, checked against
+// the bytes left), then `get` reads each element in place.
+template <class T, class Get>
+void getSequence(CdrReader &r, const char *field, size_t minElementBytes, std::vector<T> &v, Get get) {
+    v.resize(r.count(field, minElementBytes));
+    for (T &e : v) get(e);
+}
+Image getImage(CdrReader &r) {
+    Image m;
+    getSized(r, m);
     m.encoding = r.str("encoding");
     m.is_bigendian = r.u8("is_bigendian");
     m.step = r.u32("step");
@@ -278,9 +297,7 @@ std::vector<uint8_t> encode(const CompressedImage &m) {
 
 std::vector<uint8_t> encode(const CameraInfo &m) {
     CdrWriter w;
-    put(w, m.header);
-    w.u32(m.height);
-    w.u32(m.width);
+    putSized(w, m);
     w.str(m.distortion_model);
     w.u32(static_cast<uint32_t>(m.d.size()));
     w.f64s(m.d.data(), m.d.size());
@@ -296,16 +313,13 @@ std::vector<uint8_t> encode(const CameraInfo &m) {
 std::vector<uint8_t> encode(const PointCloud2 &m) {
     CdrWriter w;
     w.data().reserve(256 + m.size);
-    put(w, m.header);
-    w.u32(m.height);
-    w.u32(m.width);
-    w.u32(static_cast<uint32_t>(m.fields.size()));
-    for (const PointField &f : m.fields) {
+    putSized(w, m);
+    putSequence(w, m.fields, [&](const PointField &f) {
         w.str(f.name);
         w.u32(f.offset);
         w.u8(f.datatype);
         w.u32(f.count);
-    }
+    });
     w.u8(m.is_bigendian ? 1 : 0);
     w.u32(m.point_step);
     w.u32(m.row_step);
@@ -331,18 +345,16 @@ std::vector<uint8_t> encode(const DisparityImage &m) {
 std::vector<uint8_t> encode(const DiagnosticArray &m) {
     CdrWriter w;
     put(w, m.header);
-    w.u32(static_cast<uint32_t>(m.status.size()));
-    for (const DiagnosticStatus &s : m.status) {
+    putSequence(w, m.status, [&](const DiagnosticStatus &s) {
         w.u8(s.level);
         w.str(s.name);
         w.str(s.message);
         w.str(s.hardware_id);
-        w.u32(static_cast<uint32_t>(s.values.size()));
-        for (const auto &[k, v] : s.values) {
-            w.str(k);
-            w.str(v);
-        }
-    }
+        putSequence(w, s.values, [&](const std::pair<std::string, std::string> &kv) {
+            w.str(kv.first);
+            w.str(kv.second);
+        });
+    });
     return std::move(w.data());
 }
 
@@ -370,13 +382,9 @@ CompressedImage decodeCompressedImage(const uint8_t *data, size_t size) {
 CameraInfo decodeCameraInfo(const uint8_t *data, size_t size) {
     CdrReader r(data, size, CameraInfo::kType);
     CameraInfo m;
-    m.header = getHeader(r);
-    m.height = r.u32("height");
-    m.width = r.u32("width");
+    getSized(r, m);
     m.distortion_model = r.str("distortion_model");
-    const uint32_t n = r.count("d", 8);
-    m.d.resize(n);
-    for (double &v : m.d) v = r.f64("d");
+    getSequence(r, "d", 8, m.d, [&](double &v) { v = r.f64("d"); });
     for (double &v : m.k) v = r.f64("k");
     for (double &v : m.r) v = r.f64("r");
     for (double &v : m.p) v = r.f64("p");
@@ -389,17 +397,13 @@ CameraInfo decodeCameraInfo(const uint8_t *data, size_t size) {
 PointCloud2 decodePointCloud2(const uint8_t *data, size_t size) {
     CdrReader r(data, size, PointCloud2::kType);
     PointCloud2 m;
-    m.header = getHeader(r);
-    m.height = r.u32("height");
-    m.width = r.u32("width");
-    const uint32_t n = r.count("fields", 13);
-    m.fields.resize(n);
-    for (PointField &f : m.fields) {
+    getSized(r, m);
+    getSequence(r, "fields", 13, m.fields, [&](PointField &f) {
         f.name = r.str("fields.name");
         f.offset = r.u32("fields.offset");
         f.datatype = r.u8("fields.datatype");
         f.count = r.u32("fields.count");
-    }
+    });
     m.is_bigendian = r.u8("is_bigendian") != 0;
     m.point_step = r.u32("point_step");
     m.row_step = r.u32("row_step");
@@ -426,19 +430,16 @@ DiagnosticArray decodeDiagnosticArray(const uint8_t *data, size_t size) {
     CdrReader r(data, size, DiagnosticArray::kType);
     DiagnosticArray m;
     m.header = getHeader(r);
-    const uint32_t n = r.count("status", 17);
-    m.status.resize(n);
-    for (DiagnosticStatus &s : m.status) {
+    getSequence(r, "status", 17, m.status, [&](DiagnosticStatus &s) {
         s.level = r.u8("status.level");
         s.name = r.str("status.name");
         s.message = r.str("status.message");
         s.hardware_id = r.str("status.hardware_id");
-        const uint32_t k = r.count("status.values", 8);
-        for (uint32_t i = 0; i < k; ++i) {
-            std::string key = r.str("values.key");
-            s.values.emplace_back(std::move(key), r.str("values.value"));
-        }
-    }
+        getSequence(r, "status.values", 8, s.values, [&](std::pair<std::string, std::string> &kv) {
+            kv.first = r.str("values.key");
+            kv.second = r.str("values.value");
+        });
+    });
     return m;
 }
 

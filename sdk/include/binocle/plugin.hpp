@@ -508,16 +508,25 @@ inline binocle_plugin_header header(uint32_t size, int32_t kind, const char *nam
     return binocle_plugin_header{size, BINOCLE_ABI_VERSION, BINOCLE_API_VERSION, kind, name, version, description};
 }
 
+// A kind's table with the entries every kind's table begins with filled in: the header,
+// T's settings, and create, destroy and last_error on `Wrapper` behind handles `Handle`.
+template <class Table, class T, class Wrapper, class Handle>
+Table tableOf(int32_t kind, const char *name, const char *version, const char *description) {
+    Table t{};
+    t.header = header(sizeof(t), kind, name, version, description);
+    t.params = paramsOf<T>().data();
+    t.param_count = static_cast<int32_t>(paramsOf<T>().size());
+    t.create = &create<Wrapper, Handle>;
+    t.destroy = &destroy<Wrapper, Handle>;
+    t.last_error = &lastError<Wrapper, Handle>;
+    return t;
+}
+
 template <class T>
 const binocle_source_api *sourceTable(const char *name, const char *version, const char *description) {
     static const binocle_source_api table = [&] {
-        binocle_source_api t{};
-        t.header = header(sizeof(t), BINOCLE_KIND_STEREO_SOURCE, name, version, description);
-        t.params = paramsOf<T>().data();
-        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
-        t.create = &create<SourceInstance<T>, binocle_source>;
-        t.destroy = &destroy<SourceInstance<T>, binocle_source>;
-        t.last_error = &lastError<SourceInstance<T>, binocle_source>;
+        auto t = tableOf<binocle_source_api, T, SourceInstance<T>, binocle_source>(
+            BINOCLE_KIND_STEREO_SOURCE, name, version, description);
         t.start = &sourceStart<T>;
         t.stop = &sourceStop<T>;
         t.grab = &sourceGrab<T>;
@@ -533,13 +542,8 @@ const binocle_source_api *sourceTable(const char *name, const char *version, con
 template <class T>
 const binocle_matcher_api *matcherTable(const char *name, const char *version, const char *description) {
     static const binocle_matcher_api table = [&] {
-        binocle_matcher_api t{};
-        t.header = header(sizeof(t), BINOCLE_KIND_MATCHER, name, version, description);
-        t.params = paramsOf<T>().data();
-        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
-        t.create = &create<Instance<T>, binocle_matcher>;
-        t.destroy = &destroy<Instance<T>, binocle_matcher>;
-        t.last_error = &lastError<Instance<T>, binocle_matcher>;
+        auto t = tableOf<binocle_matcher_api, T, Instance<T>, binocle_matcher>(
+            BINOCLE_KIND_MATCHER, name, version, description);
         t.compute = &matcherCompute<T>;
         t.disparity_range = &matcherRange<T>;
         return t;
@@ -550,13 +554,8 @@ const binocle_matcher_api *matcherTable(const char *name, const char *version, c
 template <class T>
 const binocle_cloud_transform_api *transformTable(const char *name, const char *version, const char *description) {
     static const binocle_cloud_transform_api table = [&] {
-        binocle_cloud_transform_api t{};
-        t.header = header(sizeof(t), BINOCLE_KIND_CLOUD_TRANSFORM, name, version, description);
-        t.params = paramsOf<T>().data();
-        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
-        t.create = &create<Instance<T>, binocle_cloud_transform>;
-        t.destroy = &destroy<Instance<T>, binocle_cloud_transform>;
-        t.last_error = &lastError<Instance<T>, binocle_cloud_transform>;
+        auto t = tableOf<binocle_cloud_transform_api, T, Instance<T>, binocle_cloud_transform>(
+            BINOCLE_KIND_CLOUD_TRANSFORM, name, version, description);
         t.apply = &transformApply<T>;
         return t;
     }();
@@ -566,13 +565,8 @@ const binocle_cloud_transform_api *transformTable(const char *name, const char *
 template <class T>
 const binocle_evaluator_api *evaluatorTable(const char *name, const char *version, const char *description) {
     static const binocle_evaluator_api table = [&] {
-        binocle_evaluator_api t{};
-        t.header = header(sizeof(t), BINOCLE_KIND_EVALUATOR, name, version, description);
-        t.params = paramsOf<T>().data();
-        t.param_count = static_cast<int32_t>(paramsOf<T>().size());
-        t.create = &create<Instance<T>, binocle_evaluator>;
-        t.destroy = &destroy<Instance<T>, binocle_evaluator>;
-        t.last_error = &lastError<Instance<T>, binocle_evaluator>;
+        auto t = tableOf<binocle_evaluator_api, T, Instance<T>, binocle_evaluator>(
+            BINOCLE_KIND_EVALUATOR, name, version, description);
         t.evaluate = &evaluatorEvaluate<T>;
         t.finish = &evaluatorFinish<T>;
         return t;
