@@ -265,16 +265,12 @@ void Layout::copyInto(uint8_t *base) const {
 }
 
 void putImage(Writer &w, const binocle_image &placed) {
-    w.put<int32_t>(placed.width).put<int32_t>(placed.height).put<int32_t>(placed.stride_bytes).put<int32_t>(placed.format);
+    put(w, placed);
     w.put<uint64_t>(reinterpret_cast<uintptr_t>(placed.data));
 }
 
 binocle_image getImage(Reader &r, Region region) {
-    binocle_image im{};
-    im.width = r.get<int32_t>();
-    im.height = r.get<int32_t>();
-    im.stride_bytes = r.get<int32_t>();
-    im.format = r.get<int32_t>();
+    binocle_image im = get<binocle_image>(r);
     const auto offset = r.get<uint64_t>();
     const int bpp = bytesPerPixel(im.format);
     if (im.width < 0 || im.height < 0 || bpp == 0 || im.stride_bytes < static_cast<int64_t>(im.width) * bpp)
@@ -327,18 +323,14 @@ binocle_stereo_frame getFrame(Reader &r, Region region, FrameTexts &texts) {
 
 void putCloud(Writer &w, Layout &layout, const binocle_cloud &c) {
     const uint64_t n = static_cast<uint64_t>(std::max<int64_t>(c.count, 0));
-    w.put<int64_t>(c.count).put<int32_t>(c.image_width).put<int32_t>(c.image_height).put<int32_t>(c.frame);
+    put(w, c);
     w.put<uint64_t>(layout.placeArray(c.xyz, 3 * n * sizeof(float)));
     w.put<uint8_t>(c.rgb != nullptr).put<uint64_t>(c.rgb ? layout.placeArray(c.rgb, 3 * n) : 0);
     w.put<uint8_t>(c.pixel != nullptr).put<uint64_t>(c.pixel ? layout.placeArray(c.pixel, n * sizeof(int32_t)) : 0);
 }
 
 binocle_cloud getCloud(Reader &r, Region region) {
-    binocle_cloud c{};
-    c.count = r.get<int64_t>();
-    c.image_width = r.get<int32_t>();
-    c.image_height = r.get<int32_t>();
-    c.frame = r.get<int32_t>();
+    binocle_cloud c = get<binocle_cloud>(r);
     if (c.count < 0) throw Error("malformed cloud between Binocle and its plugin helper");
     const uint64_t n = static_cast<uint64_t>(c.count);
     c.xyz = reinterpret_cast<float *>(arrayAt(r.get<uint64_t>(), 3 * n * sizeof(float), region));

@@ -17,6 +17,7 @@
 #include <deque>
 #include <string>
 #include <utility>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -121,17 +122,25 @@ enum Op : uint32_t {
 // When the request carries a file descriptor, it is that region's (new) file.
 constexpr uint32_t kNoRegion = 0xffffffffu;
 
-// Messages of fixed fields are described once, by the list of their fields in wire order
-// (`fields`, for a const and a mutable message alike): put() and get() both walk that
-// list, so encoding and decoding cannot drift.
+// Messages of fixed fields are described once, by the list of their fields in wire order:
+// `wireFields(const M *)` returns their member pointers (for an ABI struct, its scalar
+// fields; its arrays follow). put() and get() both walk that list, so encoding and
+// decoding cannot drift.
+// The scalar fields of the ABI's images and clouds; their arrays follow (putImage, putCloud).
+constexpr auto wireFields(const binocle_image *) {
+    return std::make_tuple(&binocle_image::width, &binocle_image::height, &binocle_image::stride_bytes, &binocle_image::format);
+}
+constexpr auto wireFields(const binocle_cloud *) {
+    return std::make_tuple(&binocle_cloud::count, &binocle_cloud::image_width, &binocle_cloud::image_height, &binocle_cloud::frame);
+}
 template <class M>
 void put(Writer &w, const M &m) {
-    M::fields(m, [&](const auto &...f) { (w.field(f), ...); });
+    std::apply([&](auto... f) { (w.field(m.*f), ...); }, wireFields(&m));
 }
 template <class M>
 M get(Reader &r) {
-    M m;
-    M::fields(m, [&](auto &...f) { (r.field(f), ...); });
+    M m{};
+    std::apply([&](auto... f) { (r.field(m.*f), ...); }, wireFields(&m));
     return m;
 }
 
@@ -140,9 +149,8 @@ struct RequestHead {
     uint32_t op = 0;
     uint32_t region = kNoRegion;
     uint64_t region_bytes = 0;
-    template <class M, class F>
-    static void fields(M &m, F &&f) { f(m.op, m.region, m.region_bytes); }
 };
+constexpr auto wireFields(const RequestHead *) { return std::make_tuple(&RequestHead::op, &RequestHead::region, &RequestHead::region_bytes); }
 
 // kCreate: the kind the host expects and the settings.
 void putCreate(Writer &w, int32_t kind, const ParamValues &params);
@@ -170,23 +178,20 @@ struct LogMessage {
     uint8_t origin = kFromPlugin;
     int32_t level = 0;
     std::string text;
-    template <class M, class F>
-    static void fields(M &m, F &&f) { f(m.origin, m.level, m.text); }
 };
+constexpr auto wireFields(const LogMessage *) { return std::make_tuple(&LogMessage::origin, &LogMessage::level, &LogMessage::text); }
 struct MetricMessage {
     static constexpr uint32_t type = kMetric;
     std::string name;
     double value = 0;
     std::string unit;
-    template <class M, class F>
-    static void fields(M &m, F &&f) { f(m.name, m.value, m.unit); }
 };
+constexpr auto wireFields(const MetricMessage *) { return std::make_tuple(&MetricMessage::name, &MetricMessage::value, &MetricMessage::unit); }
 struct TextMessage {
     static constexpr uint32_t type = kText;
     std::string name, text;
-    template <class M, class F>
-    static void fields(M &m, F &&f) { f(m.name, m.text); }
 };
+constexpr auto wireFields(const TextMessage *) { return std::make_tuple(&TextMessage::name, &TextMessage::text); }
 template <class M>
 std::string encode(const M &m) {
     Writer w;
@@ -201,9 +206,8 @@ std::string encodeReply(int32_t rc, const std::string &message, const std::strin
 struct ReplyHead {
     int32_t rc = 0;
     std::string message;
-    template <class M, class F>
-    static void fields(M &m, F &&f) { f(m.rc, m.message); }
 };
+constexpr auto wireFields(const ReplyHead *) { return std::make_tuple(&ReplyHead::rc, &ReplyHead::message); }
 
 // kDescribe's reply: a plugin header and settings table, by value.
 void putDescription(Writer &w, const binocle_plugin_header &h, const std::vector<binocle_param_desc> &params);
