@@ -34,7 +34,7 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
         int p2 = settings_.p2;
         if (settings_.p2IntensityStep > 0)
             p2 = settings_.p2 * settings_.p2IntensityStep / (settings_.p2IntensityStep + g);
-        p2Lut_[g] = static_cast<uint8_t>(std::clamp(p2, settings_.p1, 255));
+        p2ByStep_[255 + g] = p2ByStep_[255 - g] = static_cast<uint8_t>(std::clamp(p2, settings_.p1, 255));
     }
 }
 
@@ -165,7 +165,7 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
 void Engine::matchStripe(int index, int y0, int y1) {
     Stripe &s = stripes_[static_cast<size_t>(index)];
     const size_t w = static_cast<size_t>(width_), ds = pathStride(paddedDisp_);
-    const PathParams pp{settings_.p1, p2Lut_};
+    const PathParams pp{settings_.p1, p2ByStep_ + 255};
     uint8_t *rowsL = s.pathRows.data();
     uint8_t *mins = s.pathMins.data();
     // Direction i has two rows (previous, current), swapped after each image row.

@@ -48,7 +48,10 @@ using CostRowFn = void (*)(const uint64_t *left, const uint64_t *right, int widt
 // What one path direction needs besides the costs.
 struct PathParams {
     int p1;               // penalty for a change of 1 px
-    const uint8_t *p2Lut; // penalty for larger changes, by |intensity step| (256 entries, >= p1)
+    // Penalty for larger changes (>= p1) by the signed intensity step g = grey[x] -
+    // grey[previous], -255..255, at p2ByStep[g]: 511 entries from p2ByStep - 255, the
+    // same for g and -g (indexed by the difference itself: no absolute value per pixel).
+    const uint8_t *p2ByStep;
 };
 
 // One row of up to kMaxRowPaths paths whose predecessors lie in the previous row

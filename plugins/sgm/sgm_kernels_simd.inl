@@ -29,8 +29,6 @@ constexpr int kLanes16 = v_uint16::nlanes;
 constexpr int kLanes64 = v_uint64::nlanes;
 static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole vectors");
 
-inline int addSat(int a, int b) { return a + b > 255 ? 255 : a + b; }
-
 // Bits set in each 64-bit lane. OpenCV's 256-bit v_popcount takes two byte-table lookups
 // and a sum of absolute differences; a CPU with AVX-512 VPOPCNTDQ counts them in one
 // instruction (the avx512 table, sgm_kernels_avx512.cpp, the same 256-bit code otherwise).
@@ -224,9 +222,9 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
             const bool has = paths.prevL[i] && xp >= 0 && xp < width;
             prev[i] = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
             const int minPrev = has ? paths.prevMin[i][xp] : 255;
-            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            const int p2 = has ? pp.p2ByStep[grey[x] - greyPrev[xp]] : pp.p2ByStep[0];
             base[i] = vx_setall_u8(static_cast<uint8_t>(minPrev));
-            jump[i] = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            jump[i] = base[i] + vx_setall_u8(static_cast<uint8_t>(p2));
             least[i] = vx_setall_u8(255);
             out[i] = paths.curL[i] + static_cast<size_t>(x) * stride + 1;
         }
@@ -279,16 +277,16 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     const int dx = paths.dx[0];
     // Local copies: stores through uint8_t pointers may alias the caller's structures.
-    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     for (int x = 0; x < width; ++x) {
         const int xp = x + dx;
         const bool has = prevL && xp >= 0 && xp < width;
         const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
         const int minPrev = has ? prevMin[xp] : 255;
-        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[xp])] : lut[0];
+        const int p2 = has ? lut[grey[x] - greyPrev[xp]] : lut[0];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = vx_setall_u8(255);
@@ -336,9 +334,10 @@ struct HorizontalChain {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
         if (previousX < 0)
             for (int c = 0; c < chunks; ++c) prev[c] = invalid;
-        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        // The first pixel's P2 does not matter (previous costs and minimum 255, jump 255).
+        const int p2 = pp.p2ByStep[grey[x] - grey[previousX < 0 ? x : previousX]];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = invalid;
@@ -381,9 +380,10 @@ struct RegisterChain {
                                                     const PathParams &pp, const v_uint8 &p1, uint16_t *sum,
                                                     bool initSum) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
-        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        // The first pixel's P2 does not matter (previous costs and minimum 255, jump 255).
+        const int p2 = pp.p2ByStep[grey[x] - grey[previousX < 0 ? x : previousX]];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 cur[Chunks];
@@ -588,7 +588,7 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     // Local copies: the stores through uint8_t pointers below may alias anything, so the
     // compiler would otherwise load every field again at each pixel.
-    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     const WtaParams w = wp;
     // The sums of a batch of pixels first, then their winners: a winner is a long chain
@@ -607,9 +607,9 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             const bool has = prevL != nullptr;
             const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
             const int minPrev = has ? prevMin[x] : 255;
-            const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
+            const int p2 = has ? lut[grey[x] - greyPrev[x]] : lut[0];
             const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-            const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
             v_uint8 least = vx_setall_u8(255);
             v_uint16 leastSum = vx_setall_u16(0xFFFF);
             uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;

@@ -103,8 +103,10 @@ PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2) 
     c.greyPrev.resize(static_cast<size_t>(width));
     for (auto &v : c.grey) v = static_cast<uint8_t>(rng());
     for (auto &v : c.greyPrev) v = static_cast<uint8_t>(rng());
-    c.lut.resize(256);
-    for (int g = 0; g < 256; ++g) c.lut[static_cast<size_t>(g)] = static_cast<uint8_t>(std::max(p1, p2 * 16 / (16 + g)));
+    c.lut.resize(511); // by signed intensity step (PathParams::p2ByStep)
+    for (int g = 0; g < 256; ++g)
+        c.lut[static_cast<size_t>(255 + g)] = c.lut[static_cast<size_t>(255 - g)] =
+            static_cast<uint8_t>(std::max(p1, p2 * 16 / (16 + g)));
     c.sum.resize(static_cast<size_t>(width) * c.dp);
     for (auto &v : c.sum) v = static_cast<uint16_t>(rng() % 1500);
     return c;
@@ -123,7 +125,7 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
                         for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2));
                         const PathCase &c = cases[0];
-                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const size_t rowBytes = static_cast<size_t>(width) * sgm::pathStride(c.dp);
                         std::vector<std::vector<uint8_t>> la(3, std::vector<uint8_t>(rowBytes, sgm::kCostInvalid)), lb = la;
                         std::vector<std::vector<uint8_t>> ma(3, std::vector<uint8_t>(static_cast<size_t>(width))), mb = ma;
@@ -184,7 +186,7 @@ TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
         for (int numDisp : {16, 64, 96, 128, 256}) {
             const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
             const PathCase a = pathCase(rng, width, numDisp, p1, p2), b = pathCase(rng, width, numDisp, p1, p2);
-            const sgm::PathParams pp{p1, a.lut.data()};
+            const sgm::PathParams pp{p1, a.lut.data() + 255};
             std::vector<uint8_t> scratch(2 * sgm::pathStride(a.dp), sgm::kCostInvalid);
             std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
             ref().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
@@ -209,7 +211,7 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
                         const PathCase c = pathCase(rng, width, numDisp, p1, p2);
                         const PathCase kept = pathCase(rng, width, numDisp, p1, p2);
-                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const int minD = uniqueness == 10 ? 5 : 0;
                         const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
                         const size_t w = static_cast<size_t>(width);
