@@ -501,46 +501,45 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 }
 
 // ---- winner takes all -----------------------------------------------------------------
-// q = floor(n / a) for 0 <= n < 2^23, 1 <= a <= 100, by a multiplication (no integer
-// division per pixel): with M = floor(2^40 / a) + 1 = (2^40 + e) / a, 0 < e <= a,
-// n * M / 2^40 = n / a + n * e / (a * 2^40), and n * e < 2^40 keeps the floor exact.
-struct Divider {
-    int a;
-    uint64_t m;
-    explicit Divider(int divisor) : a(divisor), m((uint64_t(1) << 40) / static_cast<uint64_t>(divisor) + 1) {}
-    int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
+// d of each 16-bit lane of the vectors of a pixel's sums, for the masks of the uniqueness
+// test (a vector per kLanes16 disparities, up to 256).
+struct LaneDisparities {
+    alignas(64) uint16_t d[kDispAlign * 8];
+    LaneDisparities() {
+        for (int i = 0; i < kDispAlign * 8; ++i) d[i] = static_cast<uint16_t>(i);
+    }
 };
+const uint16_t *laneDisparities() {
+    static const LaneDisparities lanes;
+    return lanes.d;
+}
 
-// One pixel's winner takes all, its least sum m already known. Sentinels: s[-1] and
-// s[numDisp] hold 0xFFFF (never under the threshold), so b - 1 and b + 1 need no bounds.
-template <bool Sentinels = false>
-inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
-                     uint16_t *bestSum, uint16_t *disparity16) {
-    const int whole = wp.numDisp / kLanes16 * kLanes16;
-    // One more pass finds the lowest d holding the least sum and counts the sums below
-    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
-    const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
+// One pixel's winner takes all, its least sum m already known. The uniqueness test
+// (OpenCV's: not unique when some d with |d - b| > 1 has s[d] * (100 - u) < m * 100) by
+// the least sum away from b, m2: not unique exactly when m2 * (100 - u) < m * 100 (no
+// count, no division, no correction for b - 1, b, b + 1: they are masked out).
+// Vectors > 0: s holds that many vectors of sums, those at d >= numDisp 0xFFFF (never the
+// least, never below it): the loops have a constant trip count and unroll; 0: the
+// numDisp sums only, their count known at run time.
+template <int Vectors>
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp,
+                                                    const uint16_t *laneD, int16_t *best, uint16_t *bestSum,
+                                                    uint16_t *disparity16) {
+    const int whole = Vectors > 0 ? Vectors * kLanes16 : wp.numDisp / kLanes16 * kLanes16;
+    const int tail = Vectors > 0 ? whole : wp.numDisp;
     const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
-    const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
     int b = -1;
-    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
-    // Backwards, without a branch on where the least sum lies (it is anywhere: a branch
-    // would be mispredicted at every other pixel): the lowest match is the last kept.
+    // The lowest d holding the least sum, backwards, without a branch on where it lies (it
+    // is anywhere: a branch would be mispredicted at every other pixel): the last kept.
+#pragma GCC unroll 16
     for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
-        const v_uint16 v = vx_load(s + d);
         // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
         // the 16-bit mask takes a pack and a permute first.
-        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
+        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(vx_load(s + d) == vm)));
         b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
-        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
     }
-    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
-    // bytes (one sum of absolute differences) is the sum of the lanes.
-    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
-    for (int d = whole; d < wp.numDisp; ++d) {
+    for (int d = whole; d < tail; ++d)
         if (b < 0 && s[d] == m) b = d;
-        below += s[d] < threshold;
-    }
     bestSum[x] = static_cast<uint16_t>(m);
     if (x - wp.minDisparity - b < 0) {
         best[x] = -1;
@@ -548,27 +547,32 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         return;
     }
     best[x] = static_cast<int16_t>(b);
-    // Those at b - 1, b, b + 1 do not count (without a loop: its trip count varies).
-    if (Sentinels) {
-        below -= (s[b - 1] < threshold) + (s[b] < threshold) + (s[b + 1] < threshold);
-    } else {
-        const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
-        below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    // d - (b - 1), wrapped, is at most 2 exactly for b - 1, b, b + 1: those lanes become
+    // 0xFFFF (OR with the all-ones mask) before the minimum.
+    const v_uint16 lowest = vx_setall_u16(static_cast<uint16_t>(b - 1)), two = vx_setall_u16(2);
+    v_uint16 away = vx_setall_u16(0xFFFF);
+#pragma GCC unroll 16
+    for (int d = 0; d < whole; d += kLanes16) {
+        const v_uint16 offset = v_sub_wrap(vx_load(laneD + d), lowest);
+        away = v_min(away, vx_load(s + d) | v_reinterpret_as_u16(v_min(offset, two) == offset));
     }
-    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+    int m2 = leastWord(away);
+    for (int d = whole; d < tail; ++d)
+        if (std::abs(d - b) > 1) m2 = std::min<int>(m2, s[d]);
+    disparity16[x] = m2 * (100 - wp.uniquenessPercent) >= m * 100 ? refinedDisparity16(s, b, wp) : 0;
 }
 
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
             uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const Divider divide(100 - wp.uniquenessPercent);
+    const uint16_t *laneD = laneDisparities();
     for (int x = 0; x < width; ++x) {
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
         int m = leastWord(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
-        wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
+        wtaPixel<0>(s, m, x, wp, laneD, best, bestSum, disparity16);
     }
 }
 
@@ -584,7 +588,7 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
     const int stride = pathStride(paddedDisp);
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const Divider divide(100 - wp.uniquenessPercent);
+    const uint16_t *laneD = laneDisparities();
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     // Local copies: the stores through uint8_t pointers below may alias anything, so the
     // compiler would otherwise load every field again at each pixel.
@@ -592,18 +596,16 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     const WtaParams w = wp;
     // The sums of a batch of pixels first, then their winners: a winner is a long chain
-    // of dependent steps (least sum, threshold, masks, lowest d, parabola), and the
+    // of dependent steps (least sum, lowest d, least sum away from it, parabola), and the
     // chains of neighbouring pixels, side by side in the instruction stream, overlap.
     constexpr int kBatch = 8;
-    // Each pixel's sums from [kLanes16]: sentinels 0xFFFF at d = -1 and d = numDisp.
-    alignas(64) uint16_t local[kBatch][kDispAlign * 8 + 2 * kLanes16];
-    for (auto &row : local) row[kLanes16 - 1] = 0xFFFF;
+    alignas(64) uint16_t local[kBatch][kDispAlign * 8];
     int leastOf[kBatch];
     for (int x0 = 0; x0 < width; x0 += kBatch) {
         const int n = std::min(kBatch, width - x0);
         for (int j = 0; j < n; ++j) {
             const int x = x0 + j;
-            uint16_t *sums = local[j] + kLanes16;
+            uint16_t *sums = local[j];
             const bool has = prevL != nullptr;
             const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
             const int minPrev = has ? prevMin[x] : 255;
@@ -637,10 +639,10 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             int m = leastWord(leastSum);
             for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
             leastOf[j] = m;
-            sums[w.numDisp] = 0xFFFF;
+            for (int d = w.numDisp; d < paddedDisp; ++d) sums[d] = 0xFFFF; // for wtaPixel<Vectors>
         }
         for (int j = 0; j < n; ++j)
-            wtaPixel<true>(local[j] + kLanes16, leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
+            wtaPixel<Chunks * kLanes8 / kLanes16>(local[j], leastOf[j], x0 + j, w, laneD, best, bestSum, disparity16);
     }
 }
 
