@@ -30,6 +30,11 @@ constexpr uint8_t kCostInvalid = 255;
 
 static inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
 static inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
+// Bytes of scratch the horizontal kernels take: two path rows, and the P2 of each pixel
+// and its left neighbour for two rows.
+static inline size_t horizontalScratch(int width, int paddedDisp) {
+    return 2 * static_cast<size_t>(pathStride(paddedDisp)) + 2 * (static_cast<size_t>(width) + 1);
+}
 
 // Census bits of one row. rows[j] points at image column 0 of the grey row y + j - ch/2 of
 // an image padded by cw/2 columns on each side (so rows[j][x + dx] is readable for
@@ -74,7 +79,7 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
                            const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum);
 
 // One row of both horizontal paths, left to right and right to left, added to sum (or
-// stored, when initSum); scratch: 2 * pathStride(paddedDisp) bytes.
+// stored, when initSum); scratch: horizontalScratch(width, paddedDisp) bytes.
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
 

@@ -376,12 +376,11 @@ struct RegisterChain {
     RegisterChain() {
         for (auto &v : prev) v = vx_setall_u8(kCostInvalid);
     }
-    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, const uint8_t *grey,
-                                                    const PathParams &pp, const v_uint8 &p1, uint16_t *sum,
-                                                    bool initSum) {
+    // p2: P2 between x and the previous pixel (any value for the first: its previous costs
+    // and minimum are 255, so is the jump).
+    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, int p2,
+                                                    const v_uint8 &p1, uint16_t *sum, bool initSum) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
-        // The first pixel's P2 does not matter (previous costs and minimum 255, jump 255).
-        const int p2 = pp.p2ByStep[grey[x] - grey[previousX < 0 ? x : previousX]];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
@@ -416,17 +415,22 @@ struct RegisterChain {
 };
 
 // Rows rows (1 or 2), each with both chains, all side by side; stored (initSum) or added.
+// p2Rows: scratch of Rows * (width + 1) bytes for the P2 of each pixel and its left
+// neighbour, looked up once per row for both directions: p2Of[r][x] for the pair x - 1, x.
 template <int Chunks, int Rows>
 void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
-                  const PathParams &pp, uint16_t *const *sum, bool initSum) {
+                  const PathParams &pp, uint8_t *p2Rows, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    const PathParams params = pp; // a local copy: the sums' stores cannot alias it
-    const uint8_t *rowCost[Rows], *rowGrey[Rows];
+    const uint8_t *rowCost[Rows], *p2Of[Rows];
     uint16_t *rowSum[Rows];
     for (int r = 0; r < Rows; ++r) {
         rowCost[r] = cost[r];
-        rowGrey[r] = grey[r];
         rowSum[r] = sum[r];
+        uint8_t *p2 = p2Rows + r * (static_cast<size_t>(width) + 1);
+        const uint8_t *g = grey[r];
+        p2[0] = p2[width] = pp.p2ByStep[0]; // the first pixel of each direction: any value
+        for (int x = 1; x < width; ++x) p2[x] = pp.p2ByStep[g[x] - g[x - 1]];
+        p2Of[r] = p2;
     }
     RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
@@ -435,10 +439,10 @@ void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const u
         // matter; the first path to reach a pixel stores instead of adding.
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            forward[r].step(rowCost[r], paddedDisp, i, rowGrey[r], params, p1, rowSum[r], initSum && i <= xb);
+            forward[r].step(rowCost[r], paddedDisp, i, p2Of[r][i], p1, rowSum[r], initSum && i <= xb);
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            backward[r].step(rowCost[r], paddedDisp, xb, rowGrey[r], params, p1, rowSum[r], initSum && xb > i);
+            backward[r].step(rowCost[r], paddedDisp, xb, p2Of[r][xb + 1], p1, rowSum[r], initSum && xb > i);
     }
 }
 
@@ -460,30 +464,31 @@ void horizontalAny(const uint8_t *const *cost, int width, int paddedDisp, const 
 
 template <int Rows>
 void horizontal(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey, const PathParams &pp,
-                uint16_t *const *sum, bool initSum) {
+                uint8_t *scratch, uint16_t *const *sum, bool initSum) {
+    uint8_t *p2Rows = scratch + 2 * pathStride(paddedDisp);
     switch (paddedDisp / kLanes8) {
-    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
     default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
     }
 }
 
 void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
-                   uint8_t *, uint16_t *sum, bool initSum) {
-    horizontal<1>(&cost, width, paddedDisp, &grey, pp, &sum, initSum);
+                   uint8_t *scratch, uint16_t *sum, bool initSum) {
+    horizontal<1>(&cost, width, paddedDisp, &grey, pp, scratch, &sum, initSum);
 }
 
 void horizontalRows(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
-                    const uint8_t *grey1, const PathParams &pp, uint8_t *, uint16_t *sum0, uint16_t *sum1) {
+                    const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
     const uint8_t *cost[2] = {cost0, cost1}, *grey[2] = {grey0, grey1};
     uint16_t *sum[2] = {sum0, sum1};
-    horizontal<2>(cost, width, paddedDisp, grey, pp, sum, true);
+    horizontal<2>(cost, width, paddedDisp, grey, pp, scratch, sum, true);
 }
 
 void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {

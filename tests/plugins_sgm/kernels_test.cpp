@@ -171,7 +171,7 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         simd().addPathRow(cases[0].prevL.data(), width, c.dp, sb.data());
                         ASSERT_EQ(sa, sb) << "add path row, " << what;
 
-                        std::vector<uint8_t> scratch(2 * sgm::pathStride(c.dp), sgm::kCostInvalid);
+                        std::vector<uint8_t> scratch(sgm::horizontalScratch(width, c.dp), sgm::kCostInvalid);
                         sa = c.sum;
                         sb = c.sum;
                         ref().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sa.data(), init);
@@ -187,7 +187,7 @@ TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
             const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
             const PathCase a = pathCase(rng, width, numDisp, p1, p2), b = pathCase(rng, width, numDisp, p1, p2);
             const sgm::PathParams pp{p1, a.lut.data() + 255};
-            std::vector<uint8_t> scratch(2 * sgm::pathStride(a.dp), sgm::kCostInvalid);
+            std::vector<uint8_t> scratch(sgm::horizontalScratch(width, a.dp), sgm::kCostInvalid);
             std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
             ref().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
                                  scratch.data(), ra0.data(), ra1.data());
