@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
@@ -265,6 +266,42 @@ TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
                             ASSERT_EQ(sa, sb) << what;
                             ASSERT_EQ(da, db) << what;
                         }
+}
+
+// The uniqueness test at its boundary: per pixel a least sum m at b and a rival at b + k
+// (k = -3 .. 3, so also the excluded neighbours b - 1 and b + 1) whose sum is the
+// largest that fails the test, or the least that passes (s * (100 - u) against m * 100).
+TEST_P(SimdKernels, WinnerTakesAllUniquenessBoundary) {
+    for (int numDisp : {16, 64, 128})
+        for (int uniqueness : {1, 8, 15, 50}) {
+            const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp);
+            std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
+            for (int x = 0; x < width; ++x) {
+                uint16_t *s = sum.data() + static_cast<size_t>(x) * dp;
+                for (int d = 0; d < dp; ++d) s[d] = static_cast<uint16_t>(2000 + rng() % 100);
+                const int b = static_cast<int>(rng() % static_cast<unsigned>(numDisp));
+                const int m = 100 + static_cast<int>(rng() % 400);
+                const int rival = std::clamp(b + static_cast<int>(rng() % 7) - 3, 0, numDisp - 1);
+                // The least s with s * (100 - u) >= m * 100, minus 0 or 1.
+                const int passing = (m * 100 + (100 - uniqueness) - 1) / (100 - uniqueness);
+                s[b] = static_cast<uint16_t>(m);
+                if (rival != b) s[rival] = static_cast<uint16_t>(std::max(m, passing - static_cast<int>(rng() % 2)));
+            }
+            const sgm::WtaParams wp{0, numDisp, dp, uniqueness, true};
+            std::vector<int16_t> ba(static_cast<size_t>(width)), bb(static_cast<size_t>(width));
+            std::vector<uint16_t> sa(static_cast<size_t>(width)), sb(static_cast<size_t>(width));
+            std::vector<uint16_t> da(static_cast<size_t>(width)), db(static_cast<size_t>(width));
+            ref().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
+            simd().wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
+            const std::string what = "num_disparities " + std::to_string(numDisp) + ", uniqueness " +
+                                     std::to_string(uniqueness);
+            ASSERT_EQ(ba, bb) << what;
+            ASSERT_EQ(da, db) << what;
+            // Both outcomes occur, or the boundary was not reached.
+            const auto rejected = std::count(da.begin() + numDisp, da.end(), 0);
+            EXPECT_GT(rejected, 0) << what;
+            EXPECT_LT(rejected, width - numDisp) << what;
+        }
 }
 
 // A textured pair with a step in depth, at an odd size.
