@@ -244,6 +244,22 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                     }
 }
 
+// The winner of every pixel of a row of sums, the reference's and this table's: equal.
+// disparity16: the reference's disparities, when wanted.
+void wtaEqualsTheReference(const sgm::Kernels &table, const std::vector<uint16_t> &sum, int width,
+                           const sgm::WtaParams &wp, const std::string &what,
+                           std::vector<uint16_t> *disparity16 = nullptr) {
+    const size_t n = static_cast<size_t>(width);
+    std::vector<int16_t> ba(n), bb(n);
+    std::vector<uint16_t> sa(n), sb(n), da(n), db(n);
+    sgm::scalarKernels().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
+    table.wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
+    ASSERT_EQ(ba, bb) << what;
+    ASSERT_EQ(sa, sb) << what;
+    ASSERT_EQ(da, db) << what;
+    if (disparity16) *disparity16 = da;
+}
+
 TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
     for (int width : kWidths)
         for (int numDisp : {16, 48, 64, 256})
@@ -255,16 +271,9 @@ TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
                             std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
                             for (auto &v : sum) v = static_cast<uint16_t>(rng() % range);
                             const sgm::WtaParams wp{minD, numDisp, dp, uniqueness, subpixel};
-                            std::vector<int16_t> ba(static_cast<size_t>(width)), bb(static_cast<size_t>(width));
-                            std::vector<uint16_t> sa(static_cast<size_t>(width)), sb(static_cast<size_t>(width));
-                            std::vector<uint16_t> da(static_cast<size_t>(width)), db(static_cast<size_t>(width));
-                            ref().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
-                            simd().wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
                             const std::string what = "width " + std::to_string(width) + ", num_disparities " +
                                                      std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
-                            ASSERT_EQ(ba, bb) << what;
-                            ASSERT_EQ(sa, sb) << what;
-                            ASSERT_EQ(da, db) << what;
+                            ASSERT_NO_FATAL_FAILURE(wtaEqualsTheReference(simd(), sum, width, wp, what));
                         }
 }
 
@@ -288,15 +297,10 @@ TEST_P(SimdKernels, WinnerTakesAllUniquenessBoundary) {
                 if (rival != b) s[rival] = static_cast<uint16_t>(std::max(m, passing - static_cast<int>(rng() % 2)));
             }
             const sgm::WtaParams wp{0, numDisp, dp, uniqueness, true};
-            std::vector<int16_t> ba(static_cast<size_t>(width)), bb(static_cast<size_t>(width));
-            std::vector<uint16_t> sa(static_cast<size_t>(width)), sb(static_cast<size_t>(width));
-            std::vector<uint16_t> da(static_cast<size_t>(width)), db(static_cast<size_t>(width));
-            ref().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
-            simd().wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
             const std::string what = "num_disparities " + std::to_string(numDisp) + ", uniqueness " +
                                      std::to_string(uniqueness);
-            ASSERT_EQ(ba, bb) << what;
-            ASSERT_EQ(da, db) << what;
+            std::vector<uint16_t> da;
+            ASSERT_NO_FATAL_FAILURE(wtaEqualsTheReference(simd(), sum, width, wp, what, &da));
             // Both outcomes occur, or the boundary was not reached.
             const auto rejected = std::count(da.begin() + numDisp, da.end(), 0);
             EXPECT_GT(rejected, 0) << what;
