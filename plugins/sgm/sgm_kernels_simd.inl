@@ -55,6 +55,19 @@ inline int leastByte(const v_uint8 &a) {
 #endif
 }
 
+// The least byte of a vector in every lane: the horizontal chains' minimum, kept in a
+// vector (with AVX2 broadcast from PHMINPOSUW's lane 0): no trip through a general
+// register and back on the chain's critical path.
+inline v_uint8 leastByteEverywhere(const v_uint8 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return v_uint8(_mm256_broadcastb_epi8(_mm_minpos_epu16(v)));
+#else
+    return vx_setall_u8(static_cast<uint8_t>(v_reduce_min(a)));
+#endif
+}
+
 // The least 16-bit lane, the same way.
 inline int leastWord(const v_uint16 &a) {
 #if CV_AVX2 && CV_SIMD_WIDTH == 32
@@ -371,17 +384,17 @@ struct HorizontalChain {
 template <int Chunks>
 struct RegisterChain {
     v_uint8 prev[Chunks];
-    int minPrev = 255, previousX = -1;
+    v_uint8 base; // the previous pixel's least cost, in every lane
 
     RegisterChain() {
         for (auto &v : prev) v = vx_setall_u8(kCostInvalid);
+        base = vx_setall_u8(kCostInvalid);
     }
     // p2: P2 between x and the previous pixel (any value for the first: its previous costs
     // and minimum are 255, so is the jump).
     inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, int p2,
                                                     const v_uint8 &p1, uint16_t *sum, bool initSum) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
-        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
@@ -395,8 +408,7 @@ struct RegisterChain {
             cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
             least = v_min(least, cur[c]);
         }
-        minPrev = leastByte(least);
-        previousX = x;
+        base = leastByteEverywhere(least);
 #pragma GCC unroll 8
         for (int c = 0; c < Chunks; ++c) {
             prev[c] = cur[c];
