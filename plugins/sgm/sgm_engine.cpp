@@ -34,7 +34,7 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
         int p2 = settings_.p2;
         if (settings_.p2IntensityStep > 0)
             p2 = settings_.p2 * settings_.p2IntensityStep / (settings_.p2IntensityStep + g);
-        p2Lut_[g] = static_cast<uint8_t>(std::clamp(p2, settings_.p1, 255));
+        p2ByStep_[255 + g] = p2ByStep_[255 - g] = static_cast<uint8_t>(std::clamp(p2, settings_.p1, 255));
     }
 }
 
@@ -44,7 +44,7 @@ double Engine::workingBytes(int width, int height) const {
     // 8-bit costs, and the 16-bit sums (8 paths) or the 8-bit vertical path (4 paths).
     const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
-    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + 2 * ds + w * dp * 4 /* scratch sums */ + 8 * w +
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
     return volume + images + std::max(1, settings_.stripes) * stripe;
 }
@@ -78,7 +78,7 @@ void Engine::prepare(int width, int height) {
         // The sentinels at d = -1 and d = Dp are written here once and never again.
         s.pathRows.assign(6 * w * ds, kCostInvalid);
         s.pathMins.assign(6 * w, 0);
-        s.horizontal.assign(2 * ds, kCostInvalid);
+        s.horizontal.assign(horizontalScratch(width, paddedDisp_), kCostInvalid);
         s.scratchSum.assign(2 * w * dp, 0); // two rows: the horizontal paths run two at once
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
@@ -165,7 +165,7 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
 void Engine::matchStripe(int index, int y0, int y1) {
     Stripe &s = stripes_[static_cast<size_t>(index)];
     const size_t w = static_cast<size_t>(width_), ds = pathStride(paddedDisp_);
-    const PathParams pp{settings_.p1, p2Lut_};
+    const PathParams pp{settings_.p1, p2ByStep_ + 255};
     uint8_t *rowsL = s.pathRows.data();
     uint8_t *mins = s.pathMins.data();
     // Direction i has two rows (previous, current), swapped after each image row.

@@ -85,7 +85,7 @@ private:
     bool twoPass_ = true;
     bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
-    uint8_t p2Lut_[256];
+    uint8_t p2ByStep_[511]; // P2 by intensity step -255..255 (PathParams::p2ByStep)
     cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
     std::vector<cv::Mat> bandOut_; // per band of the median: its filtered rows
     std::vector<uint64_t> censusLeft_, censusRight_;

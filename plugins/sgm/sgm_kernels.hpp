@@ -30,6 +30,11 @@ constexpr uint8_t kCostInvalid = 255;
 
 static inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
 static inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
+// Bytes of scratch the horizontal kernels take: two path rows, and the P2 of each pixel
+// and its left neighbour for two rows.
+static inline size_t horizontalScratch(int width, int paddedDisp) {
+    return 2 * static_cast<size_t>(pathStride(paddedDisp)) + 2 * (static_cast<size_t>(width) + 1);
+}
 
 // Census bits of one row. rows[j] points at image column 0 of the grey row y + j - ch/2 of
 // an image padded by cw/2 columns on each side (so rows[j][x + dx] is readable for
@@ -48,7 +53,10 @@ using CostRowFn = void (*)(const uint64_t *left, const uint64_t *right, int widt
 // What one path direction needs besides the costs.
 struct PathParams {
     int p1;               // penalty for a change of 1 px
-    const uint8_t *p2Lut; // penalty for larger changes, by |intensity step| (256 entries, >= p1)
+    // Penalty for larger changes (>= p1) by the signed intensity step g = grey[x] -
+    // grey[previous], -255..255, at p2ByStep[g]: 511 entries from p2ByStep - 255, the
+    // same for g and -g (indexed by the difference itself: no absolute value per pixel).
+    const uint8_t *p2ByStep;
 };
 
 // One row of up to kMaxRowPaths paths whose predecessors lie in the previous row
@@ -71,7 +79,7 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
                            const uint8_t *greyPrev, const PathParams &pp, uint16_t *sum, bool initSum);
 
 // One row of both horizontal paths, left to right and right to left, added to sum (or
-// stored, when initSum); scratch: 2 * pathStride(paddedDisp) bytes.
+// stored, when initSum); scratch: horizontalScratch(width, paddedDisp) bytes.
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
 

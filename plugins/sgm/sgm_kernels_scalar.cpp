@@ -78,7 +78,7 @@ void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPath
             const bool has = paths.prevL[i] && xp >= 0 && xp < width;
             const uint8_t *prev = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
             const int minPrev = has ? paths.prevMin[i][xp] : 255;
-            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            const int p2 = has ? pp.p2ByStep[grey[x] - greyPrev[xp]] : pp.p2ByStep[0];
             paths.curMin[i][x] = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2,
                                           paths.curL[i] + static_cast<size_t>(x) * stride + 1,
                                           sum ? sum + static_cast<size_t>(x) * paddedDisp : nullptr, paddedDisp,
@@ -94,7 +94,7 @@ void horizontalPath(const uint8_t *cost, int width, int paddedDisp, bool forward
     int minPrev = 255, previousX = -1;
     for (int i = 0; i < width; ++i) {
         const int x = forward ? i : width - 1 - i;
-        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        const int p2 = previousX < 0 ? pp.p2ByStep[0] : pp.p2ByStep[grey[x] - grey[previousX]];
         uint8_t *out = bufs[i & 1];
         minPrev = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2, out,
                            sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum);

@@ -29,8 +29,6 @@ constexpr int kLanes16 = v_uint16::nlanes;
 constexpr int kLanes64 = v_uint64::nlanes;
 static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole vectors");
 
-inline int addSat(int a, int b) { return a + b > 255 ? 255 : a + b; }
-
 // Bits set in each 64-bit lane. OpenCV's 256-bit v_popcount takes two byte-table lookups
 // and a sum of absolute differences; a CPU with AVX-512 VPOPCNTDQ counts them in one
 // instruction (the avx512 table, sgm_kernels_avx512.cpp, the same 256-bit code otherwise).
@@ -54,6 +52,19 @@ inline int leastByte(const v_uint8 &a) {
     return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFF;
 #else
     return v_reduce_min(a);
+#endif
+}
+
+// The least byte of a vector in every lane: the horizontal chains' minimum, kept in a
+// vector (with AVX2 broadcast from PHMINPOSUW's lane 0): no trip through a general
+// register and back on the chain's critical path.
+inline v_uint8 leastByteEverywhere(const v_uint8 &a) {
+#if CV_AVX2 && CV_SIMD_WIDTH == 32
+    __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return v_uint8(_mm256_broadcastb_epi8(_mm_minpos_epu16(v)));
+#else
+    return vx_setall_u8(static_cast<uint8_t>(v_reduce_min(a)));
 #endif
 }
 
@@ -224,9 +235,9 @@ void pathRowOf(const uint8_t *cost, int width, int paddedDisp, const RowPaths &p
             const bool has = paths.prevL[i] && xp >= 0 && xp < width;
             prev[i] = has ? paths.prevL[i] + static_cast<size_t>(xp) * stride + 1 : freshPath();
             const int minPrev = has ? paths.prevMin[i][xp] : 255;
-            const int p2 = has ? pp.p2Lut[std::abs(grey[x] - greyPrev[xp])] : pp.p2Lut[0];
+            const int p2 = has ? pp.p2ByStep[grey[x] - greyPrev[xp]] : pp.p2ByStep[0];
             base[i] = vx_setall_u8(static_cast<uint8_t>(minPrev));
-            jump[i] = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            jump[i] = base[i] + vx_setall_u8(static_cast<uint8_t>(p2));
             least[i] = vx_setall_u8(255);
             out[i] = paths.curL[i] + static_cast<size_t>(x) * stride + 1;
         }
@@ -279,16 +290,16 @@ void onePathOf(const uint8_t *cost, int width, const RowPaths &paths, const uint
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     const int dx = paths.dx[0];
     // Local copies: stores through uint8_t pointers may alias the caller's structures.
-    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     for (int x = 0; x < width; ++x) {
         const int xp = x + dx;
         const bool has = prevL && xp >= 0 && xp < width;
         const uint8_t *prev = has ? prevL + static_cast<size_t>(xp) * stride + 1 : freshPath();
         const int minPrev = has ? prevMin[xp] : 255;
-        const int p2 = has ? lut[std::abs(grey[x] - greyPrev[xp])] : lut[0];
+        const int p2 = has ? lut[grey[x] - greyPrev[xp]] : lut[0];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = vx_setall_u8(255);
@@ -336,9 +347,10 @@ struct HorizontalChain {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
         if (previousX < 0)
             for (int c = 0; c < chunks; ++c) prev[c] = invalid;
-        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
+        // The first pixel's P2 does not matter (previous costs and minimum 255, jump 255).
+        const int p2 = pp.p2ByStep[grey[x] - grey[previousX < 0 ? x : previousX]];
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = invalid;
@@ -372,18 +384,18 @@ struct HorizontalChain {
 template <int Chunks>
 struct RegisterChain {
     v_uint8 prev[Chunks];
-    int minPrev = 255, previousX = -1;
+    v_uint8 base; // the previous pixel's least cost, in every lane
 
     RegisterChain() {
         for (auto &v : prev) v = vx_setall_u8(kCostInvalid);
+        base = vx_setall_u8(kCostInvalid);
     }
-    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, const uint8_t *grey,
-                                                    const PathParams &pp, const v_uint8 &p1, uint16_t *sum,
-                                                    bool initSum) {
+    // p2: P2 between x and the previous pixel (any value for the first: its previous costs
+    // and minimum are 255, so is the jump).
+    inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, int p2,
+                                                    const v_uint8 &p1, uint16_t *sum, bool initSum) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
-        const int p2 = previousX < 0 ? pp.p2Lut[0] : pp.p2Lut[std::abs(grey[x] - grey[previousX])];
-        const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-        const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+        const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 cur[Chunks];
@@ -396,8 +408,7 @@ struct RegisterChain {
             cur[c] = vx_load(c0 + c * kLanes8) + (t - base);
             least = v_min(least, cur[c]);
         }
-        minPrev = leastByte(least);
-        previousX = x;
+        base = leastByteEverywhere(least);
 #pragma GCC unroll 8
         for (int c = 0; c < Chunks; ++c) {
             prev[c] = cur[c];
@@ -416,17 +427,22 @@ struct RegisterChain {
 };
 
 // Rows rows (1 or 2), each with both chains, all side by side; stored (initSum) or added.
+// p2Rows: scratch of Rows * (width + 1) bytes for the P2 of each pixel and its left
+// neighbour, looked up once per row for both directions: p2Of[r][x] for the pair x - 1, x.
 template <int Chunks, int Rows>
 void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
-                  const PathParams &pp, uint16_t *const *sum, bool initSum) {
+                  const PathParams &pp, uint8_t *p2Rows, uint16_t *const *sum, bool initSum) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    const PathParams params = pp; // a local copy: the sums' stores cannot alias it
-    const uint8_t *rowCost[Rows], *rowGrey[Rows];
+    const uint8_t *rowCost[Rows], *p2Of[Rows];
     uint16_t *rowSum[Rows];
     for (int r = 0; r < Rows; ++r) {
         rowCost[r] = cost[r];
-        rowGrey[r] = grey[r];
         rowSum[r] = sum[r];
+        uint8_t *p2 = p2Rows + r * (static_cast<size_t>(width) + 1);
+        const uint8_t *g = grey[r];
+        p2[0] = p2[width] = pp.p2ByStep[0]; // the first pixel of each direction: any value
+        for (int x = 1; x < width; ++x) p2[x] = pp.p2ByStep[g[x] - g[x - 1]];
+        p2Of[r] = p2;
     }
     RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
@@ -435,10 +451,10 @@ void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const u
         // matter; the first path to reach a pixel stores instead of adding.
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            forward[r].step(rowCost[r], paddedDisp, i, rowGrey[r], params, p1, rowSum[r], initSum && i <= xb);
+            forward[r].step(rowCost[r], paddedDisp, i, p2Of[r][i], p1, rowSum[r], initSum && i <= xb);
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            backward[r].step(rowCost[r], paddedDisp, xb, rowGrey[r], params, p1, rowSum[r], initSum && xb > i);
+            backward[r].step(rowCost[r], paddedDisp, xb, p2Of[r][xb + 1], p1, rowSum[r], initSum && xb > i);
     }
 }
 
@@ -460,30 +476,31 @@ void horizontalAny(const uint8_t *const *cost, int width, int paddedDisp, const 
 
 template <int Rows>
 void horizontal(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey, const PathParams &pp,
-                uint16_t *const *sum, bool initSum) {
+                uint8_t *scratch, uint16_t *const *sum, bool initSum) {
+    uint8_t *p2Rows = scratch + 2 * pathStride(paddedDisp);
     switch (paddedDisp / kLanes8) {
-    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
-    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
+    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
     default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
     }
 }
 
 void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
-                   uint8_t *, uint16_t *sum, bool initSum) {
-    horizontal<1>(&cost, width, paddedDisp, &grey, pp, &sum, initSum);
+                   uint8_t *scratch, uint16_t *sum, bool initSum) {
+    horizontal<1>(&cost, width, paddedDisp, &grey, pp, scratch, &sum, initSum);
 }
 
 void horizontalRows(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
-                    const uint8_t *grey1, const PathParams &pp, uint8_t *, uint16_t *sum0, uint16_t *sum1) {
+                    const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
     const uint8_t *cost[2] = {cost0, cost1}, *grey[2] = {grey0, grey1};
     uint16_t *sum[2] = {sum0, sum1};
-    horizontal<2>(cost, width, paddedDisp, grey, pp, sum, true);
+    horizontal<2>(cost, width, paddedDisp, grey, pp, scratch, sum, true);
 }
 
 void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
@@ -501,46 +518,45 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 }
 
 // ---- winner takes all -----------------------------------------------------------------
-// q = floor(n / a) for 0 <= n < 2^23, 1 <= a <= 100, by a multiplication (no integer
-// division per pixel): with M = floor(2^40 / a) + 1 = (2^40 + e) / a, 0 < e <= a,
-// n * M / 2^40 = n / a + n * e / (a * 2^40), and n * e < 2^40 keeps the floor exact.
-struct Divider {
-    int a;
-    uint64_t m;
-    explicit Divider(int divisor) : a(divisor), m((uint64_t(1) << 40) / static_cast<uint64_t>(divisor) + 1) {}
-    int operator()(int n) const { return static_cast<int>((static_cast<uint64_t>(n) * m) >> 40); }
+// d of each 16-bit lane of the vectors of a pixel's sums, for the masks of the uniqueness
+// test (a vector per kLanes16 disparities, up to 256).
+struct LaneDisparities {
+    alignas(64) uint16_t d[kDispAlign * 8];
+    LaneDisparities() {
+        for (int i = 0; i < kDispAlign * 8; ++i) d[i] = static_cast<uint16_t>(i);
+    }
 };
+const uint16_t *laneDisparities() {
+    static const LaneDisparities lanes;
+    return lanes.d;
+}
 
-// One pixel's winner takes all, its least sum m already known. Sentinels: s[-1] and
-// s[numDisp] hold 0xFFFF (never under the threshold), so b - 1 and b + 1 need no bounds.
-template <bool Sentinels = false>
-inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp, const Divider &divide, int16_t *best,
-                     uint16_t *bestSum, uint16_t *disparity16) {
-    const int whole = wp.numDisp / kLanes16 * kLanes16;
-    // One more pass finds the lowest d holding the least sum and counts the sums below
-    // the uniqueness threshold: s[d] * (100 - u) < m * 100  <=>  s[d] < ceil(m * 100 / (100 - u)).
-    const int threshold = std::min(65535, divide(m * 100 + divide.a - 1));
+// One pixel's winner takes all, its least sum m already known. The uniqueness test
+// (OpenCV's: not unique when some d with |d - b| > 1 has s[d] * (100 - u) < m * 100) by
+// the least sum away from b, m2: not unique exactly when m2 * (100 - u) < m * 100 (no
+// count, no division, no correction for b - 1, b, b + 1: they are masked out).
+// Vectors > 0: s holds that many vectors of sums, those at d >= numDisp 0xFFFF (never the
+// least, never below it): the loops have a constant trip count and unroll; 0: the
+// numDisp sums only, their count known at run time.
+template <int Vectors>
+inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp,
+                                                    const uint16_t *laneD, int16_t *best, uint16_t *bestSum,
+                                                    uint16_t *disparity16) {
+    const int whole = Vectors > 0 ? Vectors * kLanes16 : wp.numDisp / kLanes16 * kLanes16;
+    const int tail = Vectors > 0 ? whole : wp.numDisp;
     const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
-    const v_uint16 vt = vx_setall_u16(static_cast<uint16_t>(threshold));
     int b = -1;
-    v_uint16 counts = vx_setzero_u16(); // lanes below the threshold, counted per lane (a true lane is all ones)
-    // Backwards, without a branch on where the least sum lies (it is anywhere: a branch
-    // would be mispredicted at every other pixel): the lowest match is the last kept.
+    // The lowest d holding the least sum, backwards, without a branch on where it lies (it
+    // is anywhere: a branch would be mispredicted at every other pixel): the last kept.
+#pragma GCC unroll 16
     for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
-        const v_uint16 v = vx_load(s + d);
         // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
         // the 16-bit mask takes a pack and a permute first.
-        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(v == vm)));
+        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(vx_load(s + d) == vm)));
         b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
-        counts = v_sub_wrap(counts, v_reinterpret_as_u16(v < vt));
     }
-    // Each lane counts at most 256 / kLanes16 <= 32: its high byte is 0, so the sum of the
-    // bytes (one sum of absolute differences) is the sum of the lanes.
-    int below = static_cast<int>(v_reduce_sum(v_reinterpret_as_u8(counts)));
-    for (int d = whole; d < wp.numDisp; ++d) {
+    for (int d = whole; d < tail; ++d)
         if (b < 0 && s[d] == m) b = d;
-        below += s[d] < threshold;
-    }
     bestSum[x] = static_cast<uint16_t>(m);
     if (x - wp.minDisparity - b < 0) {
         best[x] = -1;
@@ -548,27 +564,32 @@ inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, in
         return;
     }
     best[x] = static_cast<int16_t>(b);
-    // Those at b - 1, b, b + 1 do not count (without a loop: its trip count varies).
-    if (Sentinels) {
-        below -= (s[b - 1] < threshold) + (s[b] < threshold) + (s[b + 1] < threshold);
-    } else {
-        const int lower = b > 0 ? b - 1 : b, upper = b + 1 < wp.numDisp ? b + 1 : b;
-        below -= (s[b] < threshold) + ((lower < b) & (s[lower] < threshold)) + ((upper > b) & (s[upper] < threshold));
+    // d - (b - 1), wrapped, is at most 2 exactly for b - 1, b, b + 1: those lanes become
+    // 0xFFFF (OR with the all-ones mask) before the minimum.
+    const v_uint16 lowest = vx_setall_u16(static_cast<uint16_t>(b - 1)), two = vx_setall_u16(2);
+    v_uint16 away = vx_setall_u16(0xFFFF);
+#pragma GCC unroll 16
+    for (int d = 0; d < whole; d += kLanes16) {
+        const v_uint16 offset = v_sub_wrap(vx_load(laneD + d), lowest);
+        away = v_min(away, vx_load(s + d) | v_reinterpret_as_u16(v_min(offset, two) == offset));
     }
-    disparity16[x] = below == 0 ? refinedDisparity16(s, b, wp) : 0;
+    int m2 = leastWord(away);
+    for (int d = whole; d < tail; ++d)
+        if (std::abs(d - b) > 1) m2 = std::min<int>(m2, s[d]);
+    disparity16[x] = m2 * (100 - wp.uniquenessPercent) >= m * 100 ? refinedDisparity16(s, b, wp) : 0;
 }
 
 void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
             uint16_t *disparity16) {
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const Divider divide(100 - wp.uniquenessPercent);
+    const uint16_t *laneD = laneDisparities();
     for (int x = 0; x < width; ++x) {
         const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
         v_uint16 least = vx_setall_u16(0xFFFF);
         for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
         int m = leastWord(least);
         for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
-        wtaPixel(s, m, x, wp, divide, best, bestSum, disparity16);
+        wtaPixel<0>(s, m, x, wp, laneD, best, bestSum, disparity16);
     }
 }
 
@@ -584,32 +605,30 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
     const int stride = pathStride(paddedDisp);
     const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const Divider divide(100 - wp.uniquenessPercent);
+    const uint16_t *laneD = laneDisparities();
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     // Local copies: the stores through uint8_t pointers below may alias anything, so the
     // compiler would otherwise load every field again at each pixel.
-    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2Lut;
+    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     const WtaParams w = wp;
     // The sums of a batch of pixels first, then their winners: a winner is a long chain
-    // of dependent steps (least sum, threshold, masks, lowest d, parabola), and the
+    // of dependent steps (least sum, lowest d, least sum away from it, parabola), and the
     // chains of neighbouring pixels, side by side in the instruction stream, overlap.
     constexpr int kBatch = 8;
-    // Each pixel's sums from [kLanes16]: sentinels 0xFFFF at d = -1 and d = numDisp.
-    alignas(64) uint16_t local[kBatch][kDispAlign * 8 + 2 * kLanes16];
-    for (auto &row : local) row[kLanes16 - 1] = 0xFFFF;
+    alignas(64) uint16_t local[kBatch][kDispAlign * 8];
     int leastOf[kBatch];
     for (int x0 = 0; x0 < width; x0 += kBatch) {
         const int n = std::min(kBatch, width - x0);
         for (int j = 0; j < n; ++j) {
             const int x = x0 + j;
-            uint16_t *sums = local[j] + kLanes16;
+            uint16_t *sums = local[j];
             const bool has = prevL != nullptr;
             const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
             const int minPrev = has ? prevMin[x] : 255;
-            const int p2 = has ? lut[std::abs(grey[x] - greyPrev[x])] : lut[0];
+            const int p2 = has ? lut[grey[x] - greyPrev[x]] : lut[0];
             const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-            const v_uint8 jump = vx_setall_u8(static_cast<uint8_t>(addSat(minPrev, p2)));
+            const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
             v_uint8 least = vx_setall_u8(255);
             v_uint16 leastSum = vx_setall_u16(0xFFFF);
             uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
@@ -637,10 +656,10 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             int m = leastWord(leastSum);
             for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
             leastOf[j] = m;
-            sums[w.numDisp] = 0xFFFF;
+            for (int d = w.numDisp; d < paddedDisp; ++d) sums[d] = 0xFFFF; // for wtaPixel<Vectors>
         }
         for (int j = 0; j < n; ++j)
-            wtaPixel<true>(local[j] + kLanes16, leastOf[j], x0 + j, w, divide, best, bestSum, disparity16);
+            wtaPixel<Chunks * kLanes8 / kLanes16>(local[j], leastOf[j], x0 + j, w, laneD, best, bestSum, disparity16);
     }
 }
 

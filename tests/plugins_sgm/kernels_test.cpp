@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
@@ -103,8 +104,10 @@ PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2) 
     c.greyPrev.resize(static_cast<size_t>(width));
     for (auto &v : c.grey) v = static_cast<uint8_t>(rng());
     for (auto &v : c.greyPrev) v = static_cast<uint8_t>(rng());
-    c.lut.resize(256);
-    for (int g = 0; g < 256; ++g) c.lut[static_cast<size_t>(g)] = static_cast<uint8_t>(std::max(p1, p2 * 16 / (16 + g)));
+    c.lut.resize(511); // by signed intensity step (PathParams::p2ByStep)
+    for (int g = 0; g < 256; ++g)
+        c.lut[static_cast<size_t>(255 + g)] = c.lut[static_cast<size_t>(255 - g)] =
+            static_cast<uint8_t>(std::max(p1, p2 * 16 / (16 + g)));
     c.sum.resize(static_cast<size_t>(width) * c.dp);
     for (auto &v : c.sum) v = static_cast<uint16_t>(rng() % 1500);
     return c;
@@ -123,7 +126,7 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
                         for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2));
                         const PathCase &c = cases[0];
-                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const size_t rowBytes = static_cast<size_t>(width) * sgm::pathStride(c.dp);
                         std::vector<std::vector<uint8_t>> la(3, std::vector<uint8_t>(rowBytes, sgm::kCostInvalid)), lb = la;
                         std::vector<std::vector<uint8_t>> ma(3, std::vector<uint8_t>(static_cast<size_t>(width))), mb = ma;
@@ -169,7 +172,7 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         simd().addPathRow(cases[0].prevL.data(), width, c.dp, sb.data());
                         ASSERT_EQ(sa, sb) << "add path row, " << what;
 
-                        std::vector<uint8_t> scratch(2 * sgm::pathStride(c.dp), sgm::kCostInvalid);
+                        std::vector<uint8_t> scratch(sgm::horizontalScratch(width, c.dp), sgm::kCostInvalid);
                         sa = c.sum;
                         sb = c.sum;
                         ref().horizontalRow(c.cost.data(), width, c.dp, c.grey.data(), pp, scratch.data(), sa.data(), init);
@@ -184,8 +187,8 @@ TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
         for (int numDisp : {16, 64, 96, 128, 256}) {
             const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
             const PathCase a = pathCase(rng, width, numDisp, p1, p2), b = pathCase(rng, width, numDisp, p1, p2);
-            const sgm::PathParams pp{p1, a.lut.data()};
-            std::vector<uint8_t> scratch(2 * sgm::pathStride(a.dp), sgm::kCostInvalid);
+            const sgm::PathParams pp{p1, a.lut.data() + 255};
+            std::vector<uint8_t> scratch(sgm::horizontalScratch(width, a.dp), sgm::kCostInvalid);
             std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
             ref().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
                                  scratch.data(), ra0.data(), ra1.data());
@@ -209,7 +212,7 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
                         const PathCase c = pathCase(rng, width, numDisp, p1, p2);
                         const PathCase kept = pathCase(rng, width, numDisp, p1, p2);
-                        const sgm::PathParams pp{p1, c.lut.data()};
+                        const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const int minD = uniqueness == 10 ? 5 : 0;
                         const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
                         const size_t w = static_cast<size_t>(width);
@@ -241,6 +244,22 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                     }
 }
 
+// The winner of every pixel of a row of sums, the reference's and this table's: equal.
+// disparity16: the reference's disparities, when wanted.
+void wtaEqualsTheReference(const sgm::Kernels &table, const std::vector<uint16_t> &sum, int width,
+                           const sgm::WtaParams &wp, const std::string &what,
+                           std::vector<uint16_t> *disparity16 = nullptr) {
+    const size_t n = static_cast<size_t>(width);
+    std::vector<int16_t> ba(n), bb(n);
+    std::vector<uint16_t> sa(n), sb(n), da(n), db(n);
+    sgm::scalarKernels().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
+    table.wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
+    ASSERT_EQ(ba, bb) << what;
+    ASSERT_EQ(sa, sb) << what;
+    ASSERT_EQ(da, db) << what;
+    if (disparity16) *disparity16 = da;
+}
+
 TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
     for (int width : kWidths)
         for (int numDisp : {16, 48, 64, 256})
@@ -252,17 +271,41 @@ TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
                             std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
                             for (auto &v : sum) v = static_cast<uint16_t>(rng() % range);
                             const sgm::WtaParams wp{minD, numDisp, dp, uniqueness, subpixel};
-                            std::vector<int16_t> ba(static_cast<size_t>(width)), bb(static_cast<size_t>(width));
-                            std::vector<uint16_t> sa(static_cast<size_t>(width)), sb(static_cast<size_t>(width));
-                            std::vector<uint16_t> da(static_cast<size_t>(width)), db(static_cast<size_t>(width));
-                            ref().wtaRow(sum.data(), width, wp, ba.data(), sa.data(), da.data());
-                            simd().wtaRow(sum.data(), width, wp, bb.data(), sb.data(), db.data());
                             const std::string what = "width " + std::to_string(width) + ", num_disparities " +
                                                      std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
-                            ASSERT_EQ(ba, bb) << what;
-                            ASSERT_EQ(sa, sb) << what;
-                            ASSERT_EQ(da, db) << what;
+                            ASSERT_NO_FATAL_FAILURE(wtaEqualsTheReference(simd(), sum, width, wp, what));
                         }
+}
+
+// The uniqueness test at its boundary: per pixel a least sum m at b and a rival at b + k
+// (k = -3 .. 3, so also the excluded neighbours b - 1 and b + 1) whose sum is the
+// largest that fails the test, or the least that passes (s * (100 - u) against m * 100).
+TEST_P(SimdKernels, WinnerTakesAllUniquenessBoundary) {
+    for (int numDisp : {16, 64, 128})
+        for (int uniqueness : {1, 8, 15, 50}) {
+            const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp);
+            std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
+            for (int x = 0; x < width; ++x) {
+                uint16_t *s = sum.data() + static_cast<size_t>(x) * dp;
+                for (int d = 0; d < dp; ++d) s[d] = static_cast<uint16_t>(2000 + rng() % 100);
+                const int b = static_cast<int>(rng() % static_cast<unsigned>(numDisp));
+                const int m = 100 + static_cast<int>(rng() % 400);
+                const int rival = std::clamp(b + static_cast<int>(rng() % 7) - 3, 0, numDisp - 1);
+                // The least s with s * (100 - u) >= m * 100, minus 0 or 1.
+                const int passing = (m * 100 + (100 - uniqueness) - 1) / (100 - uniqueness);
+                s[b] = static_cast<uint16_t>(m);
+                if (rival != b) s[rival] = static_cast<uint16_t>(std::max(m, passing - static_cast<int>(rng() % 2)));
+            }
+            const sgm::WtaParams wp{0, numDisp, dp, uniqueness, true};
+            const std::string what = "num_disparities " + std::to_string(numDisp) + ", uniqueness " +
+                                     std::to_string(uniqueness);
+            std::vector<uint16_t> da;
+            ASSERT_NO_FATAL_FAILURE(wtaEqualsTheReference(simd(), sum, width, wp, what, &da));
+            // Both outcomes occur, or the boundary was not reached.
+            const auto rejected = std::count(da.begin() + numDisp, da.end(), 0);
+            EXPECT_GT(rejected, 0) << what;
+            EXPECT_LT(rejected, width - numDisp) << what;
+        }
 }
 
 // A textured pair with a step in depth, at an odd size.
