@@ -17,7 +17,7 @@ std::string mebibytes(double bytes) { return std::to_string(static_cast<long lon
 } // namespace
 
 Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(settings), kernels_(kernels) {
-    paddedDisp_ = paddedDisparities(settings_.numDisparities);
+    paddedDisp_ = paddedDisparities(settings_.numDisparities, kernels_.dispAlign);
     // 5 paths: left, right and the three from above, all in one pass down (no volume).
     // 4 and 8: the pass down keeps its sums in a volume, the pass up adds the paths from below.
     twoPass_ = settings_.paths != 5;

@@ -6,7 +6,8 @@
 // for the compiler's baseline (SSE2 on x86-64, NEON on aarch64) and, on x86-64, for
 // AVX2. The tables must agree bit for bit: tests/plugins_sgm checks it.
 //
-// Layouts shared by all kernels (D = num_disparities, Dp = D rounded up to kDispAlign):
+// Layouts shared by all kernels (D = num_disparities, Dp = D rounded up to the table's
+// Kernels::dispAlign, a whole number of its vectors):
 //  - cost row: width x Dp bytes, cost of pixel x at disparity d at [x * Dp + d];
 //    d >= D and candidates left of the right image hold kCostInvalid;
 //  - path row (L): width x (Dp + 2) bytes; pixel x's costs at [x * (Dp + 2) + 1 + d],
@@ -23,12 +24,16 @@ namespace sgm {
 // The helpers below are `static`: each file has its own copy, so the linker never hands
 // a baseline caller the copy compiled for AVX2 (sgm_kernels_avx2.cpp includes this too).
 
-// Disparity counts are padded to a multiple of this (the widest vector, AVX2's 32 bytes),
-// so that every table works on the same buffers.
+// Disparity counts are padded to a multiple of a table's dispAlign: at least this (AVX2's
+// 32 bytes, so that the scalar, baseline and AVX2 tables work on the same buffers), 64
+// for the AVX-512 table (a whole 512-bit vector). Padded counts are at most kMaxPaddedDisp.
 constexpr int kDispAlign = 32;
+constexpr int kMaxPaddedDisp = 256;
 constexpr uint8_t kCostInvalid = 255;
 
-static inline int paddedDisparities(int numDisparities) { return (numDisparities + kDispAlign - 1) / kDispAlign * kDispAlign; }
+static inline int paddedDisparities(int numDisparities, int align = kDispAlign) {
+    return (numDisparities + align - 1) / align * align;
+}
 static inline int pathStride(int paddedDisp) { return paddedDisp + 2; }
 // Bytes of scratch the horizontal kernels take: two path rows, and the P2 of each pixel
 // and its left neighbour for two rows.
@@ -119,6 +124,7 @@ using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, cons
 
 struct Kernels {
     const char *name;
+    int dispAlign; // the padded disparity counts it takes are multiples of this
     CensusRowFn censusRow;
     CostScratchFn costScratchWords;
     CostRowFn costRow;
@@ -135,8 +141,9 @@ const Kernels &scalarKernels();
 const Kernels *baselineKernels();
 // AVX2 (x86-64 only); NULL when not built in or when this CPU lacks AVX2.
 const Kernels *avx2Kernels();
-// AVX2 with AVX-512 VPOPCNTDQ and VL for the costs (x86-64 only); NULL when not built
-// in or when this CPU lacks them.
+// AVX-512 (512-bit vectors, x86-64 only: F, BW, VL, DQ, CD, VBMI, VPOPCNTDQ and
+// BITALG, as on Ice Lake, Zen 4 and later); NULL when not built in or when this CPU lacks
+// one of them.
 const Kernels *avx512Kernels();
 // The fastest table this CPU runs.
 const Kernels &bestKernels();

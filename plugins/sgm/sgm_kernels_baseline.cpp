@@ -35,8 +35,11 @@ const Kernels *avx2Kernels() {
 
 const Kernels *avx512Kernels() {
 #if defined(SGM_BUILD_AVX512)
-    static const bool supported = avx2Kernels() && __builtin_cpu_supports("avx512vl") &&
-                                  __builtin_cpu_supports("avx512vpopcntdq");
+    static const bool supported =
+        avx2Kernels() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512vbmi") &&
+        __builtin_cpu_supports("avx512vpopcntdq") && __builtin_cpu_supports("avx512bitalg");
     return supported ? avx512Table() : nullptr;
 #else
     return nullptr;

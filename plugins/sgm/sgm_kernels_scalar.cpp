@@ -61,7 +61,7 @@ uint8_t pathStep(const uint8_t *cost, const uint8_t *prev, int minPrev, int p1, 
 
 // A predecessor that is not there: every cost at the sentinel, so that L = C.
 struct Fresh {
-    uint8_t data[kDispAlign * 9 + 2];
+    uint8_t data[kMaxPaddedDisp + 2];
     Fresh() { std::fill(std::begin(data), std::end(data), kCostInvalid); }
 };
 const uint8_t *freshPath() {
@@ -159,7 +159,7 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
 } // namespace
 
 const Kernels &scalarKernels() {
-    static const Kernels k{"scalar", censusRowScalar, costScratchScalar, costRowScalar,
+    static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar,
                            pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
                            upWtaRowScalar};
     return k;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sgm: the SIMD kernels, written once with OpenCV's universal intrinsics and compiled
-// once per instruction set (sgm_kernels_baseline.cpp, sgm_kernels_avx2.cpp). The
+// once per instruction set (sgm_kernels_baseline.cpp, sgm_kernels_avx2.cpp,
+// sgm_kernels_avx512.cpp: 16-, 32- and 64-byte vectors). The
 // including file defines SGM_SIMD_NS, a namespace of its own: the same inline code
 // compiled with other flags must not be merged by the linker.
 //
@@ -27,18 +28,33 @@ using namespace cv;
 constexpr int kLanes8 = v_uint8::nlanes;
 constexpr int kLanes16 = v_uint16::nlanes;
 constexpr int kLanes64 = v_uint64::nlanes;
-static_assert(kDispAlign % kLanes8 == 0, "padded disparity counts must be whole vectors");
+// The padding of disparity counts this table takes: whole vectors, and at least the
+// AVX2 table's (so that the narrower tables share its buffers).
+constexpr int kTableDispAlign = kLanes8 > kDispAlign ? kLanes8 : kDispAlign;
+static_assert(kTableDispAlign % kLanes8 == 0 && kMaxPaddedDisp % kTableDispAlign == 0,
+              "padded disparity counts must be whole vectors");
 
 // Bits set in each 64-bit lane. OpenCV's 256-bit v_popcount takes two byte-table lookups
-// and a sum of absolute differences; a CPU with AVX-512 VPOPCNTDQ counts them in one
-// instruction (the avx512 table, sgm_kernels_avx512.cpp, the same 256-bit code otherwise).
+// and a sum of absolute differences; AVX-512 VPOPCNTDQ counts them in one instruction.
 inline v_uint64 popcount64(const v_uint64 &a) {
-#if defined(SGM_SIMD_VPOPCNT)
-    return v_uint64(_mm256_popcnt_epi64(a.val));
+#if CV_SIMD_WIDTH == 64 && CV_AVX_512VPOPCNTDQ
+    return v_uint64(_mm512_popcnt_epi64(a.val));
 #else
     return v_popcount(a);
 #endif
 }
+
+// AVX-512: a 512-bit vector's least byte (or word) folded into 128 bits, for PHMINPOSUW.
+#if CV_SIMD_WIDTH == 64
+inline __m128i foldMinU8(const __m512i a) {
+    const __m256i h = _mm256_min_epu8(_mm512_castsi512_si256(a), _mm512_extracti64x4_epi64(a, 1));
+    return _mm_min_epu8(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+}
+inline __m128i foldMinU16(const __m512i a) {
+    const __m256i h = _mm256_min_epu16(_mm512_castsi512_si256(a), _mm512_extracti64x4_epi64(a, 1));
+    return _mm_min_epu16(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+}
+#endif
 
 // The least byte of a vector: every path's minimum at every pixel, on the serial chain of
 // the horizontal paths. With AVX2 the pairs of bytes are first folded into 16-bit lanes
@@ -48,6 +64,10 @@ inline v_uint64 popcount64(const v_uint64 &a) {
 inline int leastByte(const v_uint8 &a) {
 #if CV_AVX2 && CV_SIMD_WIDTH == 32
     __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFF;
+#elif CV_SIMD_WIDTH == 64
+    __m128i v = foldMinU8(a.val);
     v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
     return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFF;
 #else
@@ -63,6 +83,10 @@ inline v_uint8 leastByteEverywhere(const v_uint8 &a) {
     __m128i v = _mm_min_epu8(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
     v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
     return v_uint8(_mm256_broadcastb_epi8(_mm_minpos_epu16(v)));
+#elif CV_SIMD_WIDTH == 64
+    __m128i v = foldMinU8(a.val);
+    v = _mm_min_epu8(v, _mm_srli_epi16(v, 8));
+    return v_uint8(_mm512_broadcastb_epi8(_mm_minpos_epu16(v)));
 #else
     return vx_setall_u8(static_cast<uint8_t>(v_reduce_min(a)));
 #endif
@@ -73,6 +97,8 @@ inline int leastWord(const v_uint16 &a) {
 #if CV_AVX2 && CV_SIMD_WIDTH == 32
     const __m128i v = _mm_min_epu16(_mm256_castsi256_si128(a.val), _mm256_extracti128_si256(a.val, 1));
     return _mm_cvtsi128_si32(_mm_minpos_epu16(v)) & 0xFFFF;
+#elif CV_SIMD_WIDTH == 64
+    return _mm_cvtsi128_si32(_mm_minpos_epu16(foldMinU16(a.val))) & 0xFFFF;
 #else
     return v_reduce_min(a);
 #endif
@@ -207,7 +233,7 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
 
 // ---- paths ----------------------------------------------------------------------------
 struct Fresh {
-    uint8_t data[kDispAlign * 9 + 2];
+    uint8_t data[kMaxPaddedDisp + 2 * kLanes8 + 2];
     Fresh() {
         for (auto &v : data) v = kCostInvalid;
     }
@@ -337,7 +363,7 @@ void pathRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pat
 // whole vectors (the d - 1 and d + 1 neighbours by lane shifts, not by loads at +-1
 // byte, which would stall on store forwarding at every pixel).
 struct HorizontalChain {
-    static constexpr int kMaxChunks = (kDispAlign * 8) / kLanes8; // 256 disparities
+    static constexpr int kMaxChunks = kMaxPaddedDisp / kLanes8;
     v_uint8 bufA[kMaxChunks], bufB[kMaxChunks];
     v_uint8 *prev = bufA, *cur = bufB;
     int minPrev = 255, previousX = -1;
@@ -517,168 +543,13 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
     }
 }
 
-// ---- winner takes all -----------------------------------------------------------------
-// d of each 16-bit lane of the vectors of a pixel's sums, for the masks of the uniqueness
-// test (a vector per kLanes16 disparities, up to 256).
-struct LaneDisparities {
-    alignas(64) uint16_t d[kDispAlign * 8];
-    LaneDisparities() {
-        for (int i = 0; i < kDispAlign * 8; ++i) d[i] = static_cast<uint16_t>(i);
-    }
-};
-const uint16_t *laneDisparities() {
-    static const LaneDisparities lanes;
-    return lanes.d;
-}
-
-// One pixel's winner takes all, its least sum m already known. The uniqueness test
-// (OpenCV's: not unique when some d with |d - b| > 1 has s[d] * (100 - u) < m * 100) by
-// the least sum away from b, m2: not unique exactly when m2 * (100 - u) < m * 100 (no
-// count, no division, no correction for b - 1, b, b + 1: they are masked out).
-// Vectors > 0: s holds that many vectors of sums, those at d >= numDisp 0xFFFF (never the
-// least, never below it): the loops have a constant trip count and unroll; 0: the
-// numDisp sums only, their count known at run time.
-template <int Vectors>
-inline __attribute__((always_inline)) void wtaPixel(const uint16_t *s, int m, int x, const WtaParams &wp,
-                                                    const uint16_t *laneD, int16_t *best, uint16_t *bestSum,
-                                                    uint16_t *disparity16) {
-    const int whole = Vectors > 0 ? Vectors * kLanes16 : wp.numDisp / kLanes16 * kLanes16;
-    const int tail = Vectors > 0 ? whole : wp.numDisp;
-    const v_uint16 vm = vx_setall_u16(static_cast<uint16_t>(m));
-    int b = -1;
-    // The lowest d holding the least sum, backwards, without a branch on where it lies (it
-    // is anywhere: a branch would be mispredicted at every other pixel): the last kept.
-#pragma GCC unroll 16
-    for (int d = whole - kLanes16; d >= 0; d -= kLanes16) {
-        // The byte mask of the 16-bit comparison (two bits a lane): one instruction, where
-        // the 16-bit mask takes a pack and a permute first.
-        const uint64_t eq = static_cast<uint32_t>(v_signmask(v_reinterpret_as_u8(vx_load(s + d) == vm)));
-        b = eq != 0 ? d + __builtin_ctzll(eq) / 2 : b;
-    }
-    for (int d = whole; d < tail; ++d)
-        if (b < 0 && s[d] == m) b = d;
-    bestSum[x] = static_cast<uint16_t>(m);
-    if (x - wp.minDisparity - b < 0) {
-        best[x] = -1;
-        disparity16[x] = 0;
-        return;
-    }
-    best[x] = static_cast<int16_t>(b);
-    // d - (b - 1), wrapped, is at most 2 exactly for b - 1, b, b + 1: those lanes become
-    // 0xFFFF (OR with the all-ones mask) before the minimum.
-    const v_uint16 lowest = vx_setall_u16(static_cast<uint16_t>(b - 1)), two = vx_setall_u16(2);
-    v_uint16 away = vx_setall_u16(0xFFFF);
-#pragma GCC unroll 16
-    for (int d = 0; d < whole; d += kLanes16) {
-        const v_uint16 offset = v_sub_wrap(vx_load(laneD + d), lowest);
-        away = v_min(away, vx_load(s + d) | v_reinterpret_as_u16(v_min(offset, two) == offset));
-    }
-    int m2 = leastWord(away);
-    for (int d = whole; d < tail; ++d)
-        if (std::abs(d - b) > 1) m2 = std::min<int>(m2, s[d]);
-    disparity16[x] = m2 * (100 - wp.uniquenessPercent) >= m * 100 ? refinedDisparity16(s, b, wp) : 0;
-}
-
-void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
-            uint16_t *disparity16) {
-    const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const uint16_t *laneD = laneDisparities();
-    for (int x = 0; x < width; ++x) {
-        const uint16_t *s = sum + static_cast<size_t>(x) * wp.paddedDisp;
-        v_uint16 least = vx_setall_u16(0xFFFF);
-        for (int d = 0; d < whole; d += kLanes16) least = v_min(least, vx_load(s + d));
-        int m = leastWord(least);
-        for (int d = whole; d < wp.numDisp; ++d) m = std::min<int>(m, s[d]);
-        wtaPixel<0>(s, m, x, wp, laneD, best, bestSum, disparity16);
-    }
-}
-
-// The pass up of 4 paths, fused (sgm_kernels.hpp): per pixel the vertical path from
-// below, the sums of the four paths in a buffer that stays in L1 (nothing 16-bit is
-// stored to the row), their minimum on the way, then the winner takes all.
-// Chunks: vectors per pixel (paddedDisp / kLanes8) when known at compile time (the loop
-// over the disparities unrolls), 0 when not.
-template <int Chunks>
-void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPaths &paths, const uint8_t *grey,
-             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
-    const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
-    const int stride = pathStride(paddedDisp);
-    const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const uint16_t *laneD = laneDisparities();
-    const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
-    // Local copies: the stores through uint8_t pointers below may alias anything, so the
-    // compiler would otherwise load every field again at each pixel.
-    const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
-    uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
-    const WtaParams w = wp;
-    // The sums of a batch of pixels first, then their winners: a winner is a long chain
-    // of dependent steps (least sum, lowest d, least sum away from it, parabola), and the
-    // chains of neighbouring pixels, side by side in the instruction stream, overlap.
-    constexpr int kBatch = 8;
-    alignas(64) uint16_t local[kBatch][kDispAlign * 8];
-    int leastOf[kBatch];
-    for (int x0 = 0; x0 < width; x0 += kBatch) {
-        const int n = std::min(kBatch, width - x0);
-        for (int j = 0; j < n; ++j) {
-            const int x = x0 + j;
-            uint16_t *sums = local[j];
-            const bool has = prevL != nullptr;
-            const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
-            const int minPrev = has ? prevMin[x] : 255;
-            const int p2 = has ? lut[grey[x] - greyPrev[x]] : lut[0];
-            const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
-            const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
-            v_uint8 least = vx_setall_u8(255);
-            v_uint16 leastSum = vx_setall_u16(0xFFFF);
-            uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
-            const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
-            const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
-            const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
-#pragma GCC unroll 8
-            for (int d = 0; d < paddedDisp; d += kLanes8) {
-                const uint8_t *q = prev + d;
-                const v_uint8 steps = v_min(vx_load(q - 1), vx_load(q + 1)) + p1;
-                const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
-                v_store(out + d, l);
-                least = v_min(least, l);
-                v_uint16 l0, l1, k0lo, k0hi;
-                v_expand(l, l0, l1);
-                v_expand(vx_load(k0 + d), k0lo, k0hi);
-                const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
-                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
-                v_store(sums + d, lo);
-                v_store(sums + d + kLanes16, hi);
-                if (d < whole) leastSum = v_min(leastSum, lo);
-                if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
-            }
-            curMin[x] = leastByte(least);
-            int m = leastWord(leastSum);
-            for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
-            leastOf[j] = m;
-            for (int d = w.numDisp; d < paddedDisp; ++d) sums[d] = 0xFFFF; // for wtaPixel<Vectors>
-        }
-        for (int j = 0; j < n; ++j)
-            wtaPixel<Chunks * kLanes8 / kLanes16>(local[j], leastOf[j], x0 + j, w, laneD, best, bestSum, disparity16);
-    }
-}
-
-void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
-    switch (paddedDisp / kLanes8) {
-#define SGM_UP_WTA(n) \
-    case n: return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
-        SGM_UP_WTA(1) SGM_UP_WTA(2) SGM_UP_WTA(4) SGM_UP_WTA(8)
-#undef SGM_UP_WTA
-    default: return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
-    }
-}
+// Winner takes all, and the fused pass up of 4 paths that ends in it.
+#include "sgm_kernels_simd_wta.inl"
 
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, censusRow, costScratch, costRow, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
+    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
     return k;
 }
 

@@ -62,7 +62,7 @@ TEST_P(SimdKernels, CostsEqualTheReference) {
     for (int width : kWidths)
         for (int minD : {0, 3, 17})
             for (int numDisp : {16, 48, 64, 128, 256}) {
-                const int dp = sgm::paddedDisparities(numDisp);
+                const int dp = sgm::paddedDisparities(numDisp, simd().dispAlign);
                 std::vector<uint64_t> left(static_cast<size_t>(width)), right(static_cast<size_t>(width));
                 for (auto &v : left) v = rng() & ((uint64_t(1) << 62) - 1);
                 for (auto &v : right) v = rng();
@@ -82,10 +82,10 @@ struct PathCase {
     std::vector<uint16_t> sum;
 };
 
-PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2) {
+PathCase pathCase(std::mt19937_64 &rng, int width, int numDisp, int p1, int p2, int align) {
     PathCase c;
     c.width = width;
-    c.dp = sgm::paddedDisparities(numDisp);
+    c.dp = sgm::paddedDisparities(numDisp, align);
     const size_t stride = sgm::pathStride(c.dp);
     c.cost.resize(static_cast<size_t>(width) * c.dp);
     for (auto &v : c.cost) v = rng() % 8 == 0 ? sgm::kCostInvalid : static_cast<uint8_t>(rng() % 63);
@@ -124,7 +124,7 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
                         const int n = static_cast<int>(dxs.size());
                         std::vector<PathCase> cases;
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
-                        for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2));
+                        for (int i = 0; i < n; ++i) cases.push_back(pathCase(rng, width, numDisp, p1, p2, simd().dispAlign));
                         const PathCase &c = cases[0];
                         const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const size_t rowBytes = static_cast<size_t>(width) * sgm::pathStride(c.dp);
@@ -186,7 +186,8 @@ TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
     for (int width : kWidths)
         for (int numDisp : {16, 64, 96, 128, 256}) {
             const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
-            const PathCase a = pathCase(rng, width, numDisp, p1, p2), b = pathCase(rng, width, numDisp, p1, p2);
+            const int align = simd().dispAlign;
+            const PathCase a = pathCase(rng, width, numDisp, p1, p2, align), b = pathCase(rng, width, numDisp, p1, p2, align);
             const sgm::PathParams pp{p1, a.lut.data() + 255};
             std::vector<uint8_t> scratch(sgm::horizontalScratch(width, a.dp), sgm::kCostInvalid);
             std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
@@ -210,8 +211,8 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                 for (int uniqueness : {0, 10, 60})
                     for (bool subpixel : {false, true}) {
                         const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
-                        const PathCase c = pathCase(rng, width, numDisp, p1, p2);
-                        const PathCase kept = pathCase(rng, width, numDisp, p1, p2);
+                        const PathCase c = pathCase(rng, width, numDisp, p1, p2, simd().dispAlign);
+                        const PathCase kept = pathCase(rng, width, numDisp, p1, p2, simd().dispAlign);
                         const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const int minD = uniqueness == 10 ? 5 : 0;
                         const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
@@ -267,7 +268,7 @@ TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
                 for (int uniqueness : {0, 5, 15, 60})
                     for (bool subpixel : {false, true})
                         for (int range : {4, 2000}) { // small ranges: many ties
-                            const int dp = sgm::paddedDisparities(numDisp);
+                            const int dp = sgm::paddedDisparities(numDisp, simd().dispAlign);
                             std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
                             for (auto &v : sum) v = static_cast<uint16_t>(rng() % range);
                             const sgm::WtaParams wp{minD, numDisp, dp, uniqueness, subpixel};
@@ -283,7 +284,7 @@ TEST_P(SimdKernels, WinnerTakesAllEqualsTheReference) {
 TEST_P(SimdKernels, WinnerTakesAllUniquenessBoundary) {
     for (int numDisp : {16, 64, 128})
         for (int uniqueness : {1, 8, 15, 50}) {
-            const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp);
+            const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp, simd().dispAlign);
             std::vector<uint16_t> sum(static_cast<size_t>(width) * dp);
             for (int x = 0; x < width; ++x) {
                 uint16_t *s = sum.data() + static_cast<size_t>(x) * dp;
