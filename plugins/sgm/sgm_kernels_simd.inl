@@ -535,10 +535,8 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
         const uint8_t *l0 = pathRow + static_cast<size_t>(x) * stride + 1;
         uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         for (int d = 0; d < paddedDisp; d += kLanes8) {
-            v_uint16 lo, hi;
-            v_expand(vx_load(l0 + d), lo, hi);
-            v_store(s0 + d, vx_load(s0 + d) + lo);
-            v_store(s0 + d + kLanes16, vx_load(s0 + d + kLanes16) + hi);
+            v_store(s0 + d, vx_load(s0 + d) + vx_load_expand(l0 + d));
+            v_store(s0 + d + kLanes16, vx_load(s0 + d + kLanes16) + vx_load_expand(l0 + d + kLanes16));
         }
     }
 }

@@ -137,11 +137,12 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
                 const v_uint8 l = vx_load(c0 + d) + (v_min(v_min(vx_load(q), steps), jump) - base);
                 v_store(out + d, l);
                 least = v_min(least, l);
-                v_uint16 l0, l1, k0lo, k0hi;
+                v_uint16 l0, l1;
                 v_expand(l, l0, l1);
-                v_expand(vx_load(k0 + d), k0lo, k0hi);
-                const v_uint16 lo = vx_load(s0 + d) + l0 + k0lo;
-                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + k0hi;
+                // The kept path widened as it is loaded (not loaded whole, then split:
+                // with 512-bit vectors GCC splits it through the stack).
+                const v_uint16 lo = vx_load(s0 + d) + l0 + vx_load_expand(k0 + d);
+                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + vx_load_expand(k0 + d + kLanes16);
                 v_store(sums + d, lo);
                 v_store(sums + d + kLanes16, hi);
                 if (d < whole) leastSum = v_min(leastSum, lo);
