@@ -64,7 +64,7 @@ public:
             Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
                 .help("refuse a pair whose working memory (with 4 or 8 paths: width x height x num_disparities x 2 bytes and more) would exceed this"),
             Param::choice("kernels", "auto", "auto|avx512|avx2|baseline|scalar")
-                .help("instruction set: auto (the fastest this CPU runs), avx512 (avx2 with AVX-512 VPOPCNTDQ costs), avx2, baseline (SSE2 / NEON) or scalar (the reference)"),
+                .help("instruction set: auto (the fastest this CPU runs), avx512 (512-bit vectors: AVX-512 F, BW, VL, DQ, CD, VBMI, VPOPCNTDQ and BITALG, as on Ice Lake and Zen 4 or later), avx2, baseline (SSE2 / NEON) or scalar (the reference)"),
         };
     }
 
@@ -154,7 +154,7 @@ private:
         }
         if (name == "avx512") {
             if (const sgm::Kernels *k = sgm::avx512Kernels()) return *k;
-            refuse("kernels = 'avx512': this CPU or this build has no AVX-512 VPOPCNTDQ and VL; expected auto, avx2, "
+            refuse("kernels = 'avx512': this CPU or this build lacks one of AVX-512 F, BW, VL, DQ, CD, VBMI, VPOPCNTDQ and BITALG; expected auto, avx2, "
                    "baseline or scalar");
         }
         return sgm::bestKernels();
