@@ -82,9 +82,8 @@ void Engine::prepare(int width, int height) {
         s.scratchSum.assign(2 * w * dp, 0); // two rows: the horizontal paths run two at once
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
-        s.rightBest.assign(w, -1);
         s.bestSum.assign(w, 0);
-        s.rightSum.assign(w, 0);
+        s.rightKey.assign(w, UINT32_MAX);
     }
     fixed_.create(height, width, CV_16UC1);
     // Bands of the median and conversion: their output rows (a band and the rows around it).
@@ -135,27 +134,25 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
     if (sum) kernels_.wtaRow(sum, width_, wtaParams(), s.best.data(), s.bestSum.data(), fixed_.ptr<uint16_t>(y));
     if (settings_.disp12MaxDiff < 0) return;
     uint16_t *out = fixed_.ptr<uint16_t>(y);
-    std::fill(s.rightBest.begin(), s.rightBest.end(), -1);
-    std::fill(s.rightSum.begin(), s.rightSum.end(), 0xFFFF);
-    // Selects instead of branches on the sums and the differences, which go either way
-    // (mispredicted often).
+    // Per right column the least (sum, d) of the left pixels that chose it, as one key:
+    // the sum in the high half, d in the low, so that one minimum keeps the least sum and,
+    // among equal sums, the least d (the leftmost such pixel, the first one met).
+    std::fill(s.rightKey.begin(), s.rightKey.end(), UINT32_MAX);
     const int16_t *best = s.best.data();
-    int16_t *rightBest = s.rightBest.data();
-    uint16_t *rightSum = s.rightSum.data();
+    const uint16_t *bestSum = s.bestSum.data();
+    uint32_t *rightKey = s.rightKey.data();
+    const int minD = settings_.minDisparity;
     for (int x = 0; x < width_; ++x) {
         const int d = best[x];
         if (d < 0) continue; // no candidate: the left margin only
-        const int xr = x - settings_.minDisparity - d;
-        const uint16_t sum = s.bestSum[x], held = rightSum[xr];
-        const bool better = sum < held;
-        rightSum[xr] = better ? sum : held;
-        rightBest[xr] = better ? static_cast<int16_t>(d) : rightBest[xr];
+        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint32_t>(d);
+        rightKey[x - minD - d] = std::min(rightKey[x - minD - d], key);
     }
     for (int x = 0; x < width_; ++x) {
         const int d = best[x];
         if (d < 0) continue;
-        const int xr = x - settings_.minDisparity - d;
-        out[x] = std::abs(rightBest[xr] - d) > settings_.disp12MaxDiff ? 0 : out[x];
+        const int rightD = static_cast<int>(rightKey[x - minD - d] & 0xFFFF);
+        out[x] = std::abs(rightD - d) > settings_.disp12MaxDiff ? 0 : out[x];
     }
 }
 

@@ -58,8 +58,9 @@ private:
         std::vector<uint8_t> cost, pathRows, pathMins, horizontal;
         std::vector<uint16_t> scratchSum;
         std::vector<uint64_t> costScratch;
-        std::vector<int16_t> best, rightBest;
-        std::vector<uint16_t> bestSum, rightSum;
+        std::vector<int16_t> best;
+        std::vector<uint16_t> bestSum;
+        std::vector<uint32_t> rightKey; // the left-right check's (sum, d) per right column
     };
     void prepare(int width, int height);
     void census(const cv::Mat &left, const cv::Mat &right);
