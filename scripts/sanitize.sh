@@ -6,13 +6,13 @@
 # $BINOCLE_SANITIZE_BUILD_DIR). Builds only what it runs:
 #   1. the test executables labelled "sanitize" (host, config, replay, recorder, pipeline
 #      and the bad-input corpus) under ASan + UBSan, halting on the first finding;
-#   2. each fuzz harness for $BINOCLE_FUZZ_SECONDS seconds (default 15) from its seed
+#   2. each fuzz harness for $BINOCLE_FUZZ_SECONDS seconds (default 10) from its seed
 #      corpus in tests/fuzz/corpus/.
 # A finding fails the step. BINOCLE_SKIP_FUZZ=1 skips 2.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir="${BINOCLE_SANITIZE_BUILD_DIR:-build-sanitize}"
-seconds="${BINOCLE_FUZZ_SECONDS:-15}"
+seconds="${BINOCLE_FUZZ_SECONDS:-10}"
 jobs="$(nproc)"
 start=$(date +%s)
 # ccache (when installed), as scripts/build.sh: scripts/ccache-env.sh.
