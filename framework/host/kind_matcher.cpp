@@ -93,7 +93,7 @@ public:
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
         if (op == kRange) return wire::putRange(out, matcher_.disparityRange());
         if (op != kCompute) throw Error("helper: unknown matcher request " + std::to_string(op));
-        const wire::ComputeRequest c = wire::getComputeRequest(r);
+        const wire::ComputeRequest c = wire::get<wire::ComputeRequest>(r);
         if (c.width <= 0 || c.height <= 0 || (c.cv_type != CV_8UC1 && c.cv_type != CV_8UC3))
             throw Error("helper: malformed compute request");
         const uint64_t row = static_cast<uint64_t>(c.width) * CV_ELEM_SIZE(c.cv_type);

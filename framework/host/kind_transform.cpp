@@ -56,7 +56,7 @@ public:
             uint8_t *base = shared_.reserve(layout.bytes());
             layout.copyInto(base);
             Reply r = call(kApply, w.data(), &shared_);
-            const wire::AppliedCloud a = wire::getAppliedCloud(r.payload);
+            const wire::AppliedCloud a = wire::get<wire::AppliedCloud>(r.payload);
             if (a.count < 0 || a.count > cloud.count) throw Error("malformed cloud from the plugin helper");
             const uint64_t n = static_cast<uint64_t>(a.count);
             const wire::Region region = shared_.region();
