@@ -162,15 +162,11 @@ std::pair<int32_t, int32_t> Matcher::disparityRange() { return impl_->disparityR
 
 const PluginKind &matcherKind() {
     using T = binocle_matcher_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_MATCHER, "matcher", "matcher", PluginKind::InRig::One);
-        k.versions = {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}};
-        k.entries.push_back({"compute", offsetof(T, compute), true, kCompute});
-        k.entries.push_back({"disparity_range", offsetof(T, disparity_range), false, kRange});
-        k.lostOnRestart = "this frame has no disparity";
-        k.serve = &serveAs<ServedMatcher>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_MATCHER, "matcher", "matcher", PluginKind::InRig::One,
+        {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}},
+        {{"compute", offsetof(T, compute), true, kCompute}, {"disparity_range", offsetof(T, disparity_range), false, kRange}},
+        "this frame has no disparity", &serveAs<ServedMatcher>);
     return kind;
 }
 

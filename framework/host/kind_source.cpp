@@ -267,20 +267,17 @@ std::string Source::enumerateDevices(const PluginRecord &record) {
 
 const PluginKind &sourceKind() {
     using T = binocle_source_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_STEREO_SOURCE, "source", "source", PluginKind::InRig::One);
-        k.versions = {{1, BINOCLE_END_OF(T, enumerate_devices), "enumerate_devices"}};
-        k.entries.insert(k.entries.end(), {{"start", offsetof(T, start), false, kStart},
-                                           {"stop", offsetof(T, stop), false, kStop},
-                                           {"grab", offsetof(T, grab), true, kGrab},
-                                           {"release_frame", offsetof(T, release_frame), true, 0},
-                                           {"calibration", offsetof(T, calibration), false, kCalibration},
-                                           {"statistics", offsetof(T, statistics), false, kStatistics},
-                                           {"enumerate_devices", offsetof(T, enumerate_devices), false, 0}});
-        k.lostOnRestart = "that grab is lost; the source is created (and started) again";
-        k.serve = &serveAs<ServedSource>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_STEREO_SOURCE, "source", "source", PluginKind::InRig::One,
+        {{1, BINOCLE_END_OF(T, enumerate_devices), "enumerate_devices"}},
+        {{"start", offsetof(T, start), false, kStart},
+         {"stop", offsetof(T, stop), false, kStop},
+         {"grab", offsetof(T, grab), true, kGrab},
+         {"release_frame", offsetof(T, release_frame), true, 0},
+         {"calibration", offsetof(T, calibration), false, kCalibration},
+         {"statistics", offsetof(T, statistics), false, kStatistics},
+         {"enumerate_devices", offsetof(T, enumerate_devices), false, 0}},
+        "that grab is lost; the source is created (and started) again", &serveAs<ServedSource>);
     return kind;
 }
 

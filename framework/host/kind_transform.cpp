@@ -108,14 +108,11 @@ void CloudTransform::apply(binocle_cloud &cloud) { impl_->apply(cloud); }
 
 const PluginKind &transformKind() {
     using T = binocle_cloud_transform_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_CLOUD_TRANSFORM, "transform", "transforms", PluginKind::InRig::List);
-        k.versions = {{1, BINOCLE_END_OF(T, apply), "apply"}};
-        k.entries.push_back({"apply", offsetof(T, apply), true, kApply});
-        k.lostOnRestart = "this frame's cloud is dropped";
-        k.serve = &serveAs<ServedTransform>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_CLOUD_TRANSFORM, "transform", "transforms", PluginKind::InRig::List,
+        {{1, BINOCLE_END_OF(T, apply), "apply"}},
+        {{"apply", offsetof(T, apply), true, kApply}},
+        "this frame's cloud is dropped", &serveAs<ServedTransform>);
     return kind;
 }
 
