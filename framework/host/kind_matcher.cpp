@@ -85,13 +85,11 @@ private:
     SharedRegion shared_;
 };
 
-class ServedMatcher : public ServedInstance {
+class ServedMatcher : public ServedThrough<Matcher> {
 public:
-    ServedMatcher(const PluginRecord &record, const ParamValues &params, HostSink sink) : matcher_(record, params) {
-        matcher_.setSink(std::move(sink));
-    }
+    using ServedThrough::ServedThrough;
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
-        if (op == kRange) return wire::putRange(out, matcher_.disparityRange());
+        if (op == kRange) return wire::putRange(out, instance_.disparityRange());
         if (op != kCompute) throw Error("helper: unknown matcher request " + std::to_string(op));
         const wire::ComputeRequest c = wire::get<wire::ComputeRequest>(r);
         if (c.width <= 0 || c.height <= 0 || (c.cv_type != CV_8UC1 && c.cv_type != CV_8UC3))
@@ -103,11 +101,8 @@ public:
         cv::Mat left(c.height, c.width, c.cv_type, m.base), right(c.height, c.width, c.cv_type, m.base + c.image_bytes);
         cv::Mat disparity(c.height, c.width, CV_32F, m.base + 2 * c.image_bytes);
         disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
-        matcher_.computeInto(left, right, disparity);
+        instance_.computeInto(left, right, disparity);
     }
-
-private:
-    Matcher matcher_;
 };
 
 } // namespace

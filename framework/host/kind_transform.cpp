@@ -74,23 +74,18 @@ private:
     SharedRegion shared_;
 };
 
-class ServedTransform : public ServedInstance {
+class ServedTransform : public ServedThrough<CloudTransform> {
 public:
-    ServedTransform(const PluginRecord &record, const ParamValues &params, HostSink sink) : transform_(record, params) {
-        transform_.setSink(std::move(sink));
-    }
+    using ServedThrough::ServedThrough;
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
         if (op != kApply) throw Error("helper: unknown transform request " + std::to_string(op));
         binocle_cloud c = wire::getCloud(r, m);
-        transform_.apply(c); // the wrapper refuses a garbage cloud
+        instance_.apply(c); // the wrapper refuses a garbage cloud
         const auto offset = [&](const void *p) {
             return p ? static_cast<uint64_t>(static_cast<const uint8_t *>(p) - m.base) : 0;
         };
         wire::put(out, wire::AppliedCloud{c.count, c.frame, offset(c.xyz), offset(c.rgb), offset(c.pixel)});
     }
-
-private:
-    CloudTransform transform_;
 };
 
 } // namespace
