@@ -9,6 +9,7 @@
 // frame (both while the pipeline runs; rss_growth_after_1000_MiB is their difference)
 // (BINOCLE_SOAK_FRAMES, default 100 000; minutes):
 //   build/bench/binocle_bench --benchmark_filter=ReplaySoak
+#include "bench_plugins.hpp"
 #include "config/rig_config.hpp"
 #include "core/calibration.hpp"
 #include "method/density_grid.hpp"
@@ -79,15 +80,6 @@ const Pair &pairAt(cv::Size size) {
     return made.emplace(key, p).first->second;
 }
 
-const binocle::PluginHost &host() {
-    static const std::unique_ptr<binocle::PluginHost> h = [] {
-        auto p = std::make_unique<binocle::PluginHost>(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR, BINOCLE_BENCH_PLUGIN_DIR});
-        p->scan();
-        return p;
-    }();
-    return *h;
-}
-
 binocle::RigConfig rigFor(const Pair &p, bool sgbm, int matchers, bool grids, int disparities = 64) {
     std::string y = "name: bench\nsource:\n  plugin: replay\n  layout: glob\n  left: " + p.left + "\n  right: " + p.right +
                     "\n  color: gray\n  loop: true\ncalibration: " + p.calibration + "\n";
@@ -99,7 +91,7 @@ binocle::RigConfig rigFor(const Pair &p, bool sgbm, int matchers, bool grids, in
     if (grids) y += "evaluators:\n  - plugin: density_grids\n";
     y += "outputs: {disparity_png: false, disparity_color: false, cloud_ply: false, max_range_mm: " + std::to_string(kMaxRangeMm) + "}\n";
     y += "runtime:\n  matcher_instances: " + std::to_string(matchers) + "\n";
-    return binocle::rigFromNode(YAML::Load(y), p.dir + "/rig.yaml", host());
+    return binocle::rigFromNode(YAML::Load(y), p.dir + "/rig.yaml", binocle::bench::builtAndBenchPlugins());
 }
 
 // What a user would write without Binocle, one frame after the other.
@@ -185,7 +177,7 @@ void BM_PipelineVersusSerial(benchmark::State &state) {
         for (int i = 0; i < frames; ++i) check += loop.frame(steps);
         serial += since(t0);
         serialFrames += frames;
-        binocle::Pipeline pipe(rigFor(p, sgbm, matchers, true), host());
+        binocle::Pipeline pipe(rigFor(p, sgbm, matchers, true), binocle::bench::builtAndBenchPlugins());
         binocle::RunOptions o;
         o.max_frames = frames;
         o.progress = false;
@@ -230,7 +222,7 @@ void BM_ReplaySoak(benchmark::State &state) {
     const Pair &p = pairAt(cv::Size(320, 240));
     const std::string out = p.dir + "/soak";
     for (auto _ : state) {
-        binocle::Pipeline pipe(rigFor(p, false, 2, true, 32), host());
+        binocle::Pipeline pipe(rigFor(p, false, 2, true, 32), binocle::bench::builtAndBenchPlugins());
         binocle::RunOptions o;
         o.max_frames = frames;
         o.progress = false;

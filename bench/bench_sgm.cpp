@@ -8,6 +8,7 @@
 //    counting holes as errors, mean end-point error, for the three.
 //   build/bench/binocle_bench --benchmark_filter=Sgm
 // E1's accuracy comes from `binocle experiment` (plugins/sgm/README.md).
+#include "bench_plugins.hpp"
 #include "config/rig_config.hpp"
 #include "host/plugin_host.hpp"
 
@@ -25,17 +26,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const binocle::PluginHost &benchPlugins() {
-    static const std::unique_ptr<binocle::PluginHost> host = [] {
-        auto h = std::make_unique<binocle::PluginHost>(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR});
-        h->scan();
-        return h;
-    }();
-    return *host;
-}
-
 std::unique_ptr<binocle::Matcher> matcher(const std::string &plugin, const std::string &yaml) {
-    const binocle::PluginRecord &record = benchPlugins().require(plugin, BINOCLE_KIND_MATCHER);
+    const binocle::PluginRecord &record = binocle::bench::builtPlugins().require(plugin, BINOCLE_KIND_MATCHER);
     return std::make_unique<binocle::Matcher>(record, binocle::paramsFromYaml(record, yaml));
 }
 

@@ -7,6 +7,7 @@
 //   - ViewerEncodeFrame: the encoder thread's message (images, density views, cloud)
 //   build/bench/binocle_bench --benchmark_filter=Viewer
 // The whole loop with a real browser is bench/view_overhead.py.
+#include "bench_plugins.hpp"
 #include "config/rig_config.hpp"
 #include "pipeline/pipeline.hpp"
 #include "viewer/frame_snapshot.hpp"
@@ -20,27 +21,18 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const binocle::PluginHost &viewHost() {
-    static const std::unique_ptr<binocle::PluginHost> h = [] {
-        auto p = std::make_unique<binocle::PluginHost>(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR});
-        p->scan();
-        return p;
-    }();
-    return *h;
-}
-
 binocle::RigConfig simRig() {
     return binocle::loadRig(std::string(BINOCLE_SOURCE_DIR) + "/configs/rigs/sim-videre.yaml",
                             {binocle::Override::parse("outputs.disparity_png=false"),
                              binocle::Override::parse("outputs.disparity_color=false"),
                              binocle::Override::parse("outputs.cloud_ply=false")},
-                            viewHost());
+                            binocle::bench::builtPlugins());
 }
 
 // One frame of the simulated rig as the viewer holds it.
 const binocle::viewer::FrameProducts &simFrame() {
     static const binocle::viewer::FrameProducts frame = [] {
-        binocle::Pipeline pipeline(simRig(), viewHost());
+        binocle::Pipeline pipeline(simRig(), binocle::bench::builtPlugins());
         binocle::RunOptions o;
         o.max_frames = 3;
         o.progress = false;
@@ -55,7 +47,7 @@ const binocle::viewer::FrameProducts &simFrame() {
 }
 
 void BM_ViewerPipelineFrame(benchmark::State &state) {
-    binocle::Pipeline pipeline(simRig(), viewHost());
+    binocle::Pipeline pipeline(simRig(), binocle::bench::builtPlugins());
     for (auto _ : state) {
         binocle::RunOptions o;
         o.max_frames = 20;

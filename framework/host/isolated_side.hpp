@@ -22,6 +22,19 @@ public:
     virtual void call(uint32_t op, wire::Reader &r, wire::Region region, wire::Writer &out) = 0;
 };
 
+// A served instance that answers its kind's calls with the kind's wrapper (Matcher,
+// Source ...) made here, in the helper process; what the plugin logs goes to `sink`.
+template <class Wrapper>
+class ServedThrough : public ServedInstance {
+public:
+    ServedThrough(const PluginRecord &record, const ParamValues &params, HostSink sink) : instance_(record, params) {
+        instance_.setSink(std::move(sink));
+    }
+
+protected:
+    Wrapper instance_;
+};
+
 // PluginKind::serve for a served instance made as Served(record, params, sink).
 template <class Served>
 std::unique_ptr<ServedInstance> serveAs(const PluginRecord &record, const ParamValues &params, HostSink sink) {

@@ -345,19 +345,6 @@ binocle_cloud getCloud(Reader &r, Region region) {
 
 // ---- The kinds' calls ----------------------------------------------------------------------------
 
-void put(Writer &w, const ComputeRequest &c) {
-    w.put<int32_t>(c.width).put<int32_t>(c.height).put<int32_t>(c.cv_type).put<uint64_t>(c.image_bytes);
-}
-
-ComputeRequest getComputeRequest(Reader &r) {
-    ComputeRequest c;
-    c.width = r.get<int32_t>();
-    c.height = r.get<int32_t>();
-    c.cv_type = r.get<int32_t>();
-    c.image_bytes = r.get<uint64_t>();
-    return c;
-}
-
 void putRange(Writer &w, std::pair<int32_t, int32_t> range) { w.put<int32_t>(range.first).put<int32_t>(range.second); }
 
 std::pair<int32_t, int32_t> getRange(Reader &r) {
@@ -367,20 +354,6 @@ std::pair<int32_t, int32_t> getRange(Reader &r) {
 
 void putGrabRequest(Writer &w, int32_t timeout_ms) { w.put<int32_t>(timeout_ms); }
 int32_t getGrabRequest(Reader &r) { return r.get<int32_t>(); }
-
-void put(Writer &w, const AppliedCloud &c) {
-    w.put<int64_t>(c.count).put<int32_t>(c.frame).put<uint64_t>(c.xyz).put<uint64_t>(c.rgb).put<uint64_t>(c.pixel);
-}
-
-AppliedCloud getAppliedCloud(Reader &r) {
-    AppliedCloud c;
-    c.count = r.get<int64_t>();
-    c.frame = r.get<int32_t>();
-    c.xyz = r.get<uint64_t>();
-    c.rgb = r.get<uint64_t>();
-    c.pixel = r.get<uint64_t>();
-    return c;
-}
 
 void putEvaluate(Writer &w, Layout &layout, const binocle_eval_input &in, bool sendCalibration, bool sendRig) {
     w.put<uint8_t>(in.frame != nullptr);

@@ -276,8 +276,9 @@ struct ComputeRequest {
     int32_t width = 0, height = 0, cv_type = 0;
     uint64_t image_bytes = 0;
 };
-void put(Writer &w, const ComputeRequest &c);
-ComputeRequest getComputeRequest(Reader &r);
+constexpr auto wireFields(const ComputeRequest *) {
+    return std::make_tuple(&ComputeRequest::width, &ComputeRequest::height, &ComputeRequest::cv_type, &ComputeRequest::image_bytes);
+}
 
 // Matcher disparity_range's reply.
 void putRange(Writer &w, std::pair<int32_t, int32_t> range);
@@ -294,8 +295,9 @@ struct AppliedCloud {
     int32_t frame = 0;
     uint64_t xyz = 0, rgb = 0, pixel = 0;
 };
-void put(Writer &w, const AppliedCloud &c);
-AppliedCloud getAppliedCloud(Reader &r);
+constexpr auto wireFields(const AppliedCloud *) {
+    return std::make_tuple(&AppliedCloud::count, &AppliedCloud::frame, &AppliedCloud::xyz, &AppliedCloud::rgb, &AppliedCloud::pixel);
+}
 
 // Evaluator evaluate: the input's planes in a Layout. The calibration and rig texts,
 // which change rarely, are sent only when `sendTexts` (else the helper process keeps

@@ -118,15 +118,11 @@ void Evaluator::finish() { impl_->finish(); }
 
 const PluginKind &evaluatorKind() {
     using T = binocle_evaluator_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_EVALUATOR, "evaluator", "evaluators", PluginKind::InRig::List);
-        k.versions = {{1, BINOCLE_END_OF(T, finish), "finish"}};
-        k.entries.push_back({"evaluate", offsetof(T, evaluate), true, kEvaluate});
-        k.entries.push_back({"finish", offsetof(T, finish), false, kFinish});
-        k.lostOnRestart = "this frame has no figures from it, and its totals start again";
-        k.serve = &serveAs<ServedEvaluator>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_EVALUATOR, "evaluator", "evaluators", PluginKind::InRig::List,
+        {{1, BINOCLE_END_OF(T, finish), "finish"}},
+        {{"evaluate", offsetof(T, evaluate), true, kEvaluate}, {"finish", offsetof(T, finish), false, kFinish}},
+        "this frame has no figures from it, and its totals start again", &serveAs<ServedEvaluator>);
     return kind;
 }
 

@@ -85,15 +85,13 @@ private:
     SharedRegion shared_;
 };
 
-class ServedMatcher : public ServedInstance {
+class ServedMatcher : public ServedThrough<Matcher> {
 public:
-    ServedMatcher(const PluginRecord &record, const ParamValues &params, HostSink sink) : matcher_(record, params) {
-        matcher_.setSink(std::move(sink));
-    }
+    using ServedThrough::ServedThrough;
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
-        if (op == kRange) return wire::putRange(out, matcher_.disparityRange());
+        if (op == kRange) return wire::putRange(out, instance_.disparityRange());
         if (op != kCompute) throw Error("helper: unknown matcher request " + std::to_string(op));
-        const wire::ComputeRequest c = wire::getComputeRequest(r);
+        const wire::ComputeRequest c = wire::get<wire::ComputeRequest>(r);
         if (c.width <= 0 || c.height <= 0 || (c.cv_type != CV_8UC1 && c.cv_type != CV_8UC3))
             throw Error("helper: malformed compute request");
         const uint64_t row = static_cast<uint64_t>(c.width) * CV_ELEM_SIZE(c.cv_type);
@@ -103,11 +101,8 @@ public:
         cv::Mat left(c.height, c.width, c.cv_type, m.base), right(c.height, c.width, c.cv_type, m.base + c.image_bytes);
         cv::Mat disparity(c.height, c.width, CV_32F, m.base + 2 * c.image_bytes);
         disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
-        matcher_.computeInto(left, right, disparity);
+        instance_.computeInto(left, right, disparity);
     }
-
-private:
-    Matcher matcher_;
 };
 
 } // namespace
@@ -162,15 +157,11 @@ std::pair<int32_t, int32_t> Matcher::disparityRange() { return impl_->disparityR
 
 const PluginKind &matcherKind() {
     using T = binocle_matcher_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_MATCHER, "matcher", "matcher", PluginKind::InRig::One);
-        k.versions = {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}};
-        k.entries.push_back({"compute", offsetof(T, compute), true, kCompute});
-        k.entries.push_back({"disparity_range", offsetof(T, disparity_range), false, kRange});
-        k.lostOnRestart = "this frame has no disparity";
-        k.serve = &serveAs<ServedMatcher>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_MATCHER, "matcher", "matcher", PluginKind::InRig::One,
+        {{1, BINOCLE_END_OF(T, disparity_range), "disparity_range"}},
+        {{"compute", offsetof(T, compute), true, kCompute}, {"disparity_range", offsetof(T, disparity_range), false, kRange}},
+        "this frame has no disparity", &serveAs<ServedMatcher>);
     return kind;
 }
 

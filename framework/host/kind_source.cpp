@@ -194,19 +194,17 @@ private:
     bool started_ = false;
 };
 
-class ServedSource : public ServedInstance {
+class ServedSource : public ServedThrough<Source> {
 public:
     ServedSource(const PluginRecord &record, const ParamValues &params, HostSink sink)
-        : record_(record), source_(record, params) {
-        source_.setSink(std::move(sink));
-    }
+        : ServedThrough(record, params, std::move(sink)), record_(record) {}
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
         switch (op) {
-        case kStart: return source_.start();
-        case kStop: return source_.stop();
+        case kStart: return instance_.start();
+        case kStop: return instance_.stop();
         case kGrab: return grab(wire::getGrabRequest(r), m, out);
-        case kCalibration: out.str(source_.calibration()); return;
-        case kStatistics: out.str(source_.statistics()); return;
+        case kCalibration: out.str(instance_.calibration()); return;
+        case kStatistics: out.str(instance_.statistics()); return;
         default: throw Error("helper: unknown source request " + std::to_string(op));
         }
     }
@@ -214,7 +212,7 @@ public:
 private:
     void grab(int32_t timeout_ms, wire::Region m, wire::Writer &out) {
         if (!pending_) {
-            pending_ = source_.grab(timeout_ms);
+            pending_ = instance_.grab(timeout_ms);
             if (!pending_) throw PluginError("source plugin '" + record_.name + "': end of stream", BINOCLE_ERR_END_OF_STREAM);
         }
         // The wrapper checked the frame; its planes are copied into the host's region, and
@@ -229,7 +227,6 @@ private:
         pending_.reset();
     }
     const PluginRecord &record_;
-    Source source_;
     std::unique_ptr<LentFrame> pending_; // grabbed, waiting for a region large enough
 };
 
@@ -267,20 +264,17 @@ std::string Source::enumerateDevices(const PluginRecord &record) {
 
 const PluginKind &sourceKind() {
     using T = binocle_source_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_STEREO_SOURCE, "source", "source", PluginKind::InRig::One);
-        k.versions = {{1, BINOCLE_END_OF(T, enumerate_devices), "enumerate_devices"}};
-        k.entries.insert(k.entries.end(), {{"start", offsetof(T, start), false, kStart},
-                                           {"stop", offsetof(T, stop), false, kStop},
-                                           {"grab", offsetof(T, grab), true, kGrab},
-                                           {"release_frame", offsetof(T, release_frame), true, 0},
-                                           {"calibration", offsetof(T, calibration), false, kCalibration},
-                                           {"statistics", offsetof(T, statistics), false, kStatistics},
-                                           {"enumerate_devices", offsetof(T, enumerate_devices), false, 0}});
-        k.lostOnRestart = "that grab is lost; the source is created (and started) again";
-        k.serve = &serveAs<ServedSource>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_STEREO_SOURCE, "source", "source", PluginKind::InRig::One,
+        {{1, BINOCLE_END_OF(T, enumerate_devices), "enumerate_devices"}},
+        {{"start", offsetof(T, start), false, kStart},
+         {"stop", offsetof(T, stop), false, kStop},
+         {"grab", offsetof(T, grab), true, kGrab},
+         {"release_frame", offsetof(T, release_frame), true, 0},
+         {"calibration", offsetof(T, calibration), false, kCalibration},
+         {"statistics", offsetof(T, statistics), false, kStatistics},
+         {"enumerate_devices", offsetof(T, enumerate_devices), false, 0}},
+        "that grab is lost; the source is created (and started) again", &serveAs<ServedSource>);
     return kind;
 }
 

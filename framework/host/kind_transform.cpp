@@ -56,7 +56,7 @@ public:
             uint8_t *base = shared_.reserve(layout.bytes());
             layout.copyInto(base);
             Reply r = call(kApply, w.data(), &shared_);
-            const wire::AppliedCloud a = wire::getAppliedCloud(r.payload);
+            const wire::AppliedCloud a = wire::get<wire::AppliedCloud>(r.payload);
             if (a.count < 0 || a.count > cloud.count) throw Error("malformed cloud from the plugin helper");
             const uint64_t n = static_cast<uint64_t>(a.count);
             const wire::Region region = shared_.region();
@@ -74,23 +74,18 @@ private:
     SharedRegion shared_;
 };
 
-class ServedTransform : public ServedInstance {
+class ServedTransform : public ServedThrough<CloudTransform> {
 public:
-    ServedTransform(const PluginRecord &record, const ParamValues &params, HostSink sink) : transform_(record, params) {
-        transform_.setSink(std::move(sink));
-    }
+    using ServedThrough::ServedThrough;
     void call(uint32_t op, wire::Reader &r, wire::Region m, wire::Writer &out) override {
         if (op != kApply) throw Error("helper: unknown transform request " + std::to_string(op));
         binocle_cloud c = wire::getCloud(r, m);
-        transform_.apply(c); // the wrapper refuses a garbage cloud
+        instance_.apply(c); // the wrapper refuses a garbage cloud
         const auto offset = [&](const void *p) {
             return p ? static_cast<uint64_t>(static_cast<const uint8_t *>(p) - m.base) : 0;
         };
         wire::put(out, wire::AppliedCloud{c.count, c.frame, offset(c.xyz), offset(c.rgb), offset(c.pixel)});
     }
-
-private:
-    CloudTransform transform_;
 };
 
 } // namespace
@@ -108,14 +103,11 @@ void CloudTransform::apply(binocle_cloud &cloud) { impl_->apply(cloud); }
 
 const PluginKind &transformKind() {
     using T = binocle_cloud_transform_api;
-    static const PluginKind kind = [] {
-        PluginKind k = tableKind<T>(BINOCLE_KIND_CLOUD_TRANSFORM, "transform", "transforms", PluginKind::InRig::List);
-        k.versions = {{1, BINOCLE_END_OF(T, apply), "apply"}};
-        k.entries.push_back({"apply", offsetof(T, apply), true, kApply});
-        k.lostOnRestart = "this frame's cloud is dropped";
-        k.serve = &serveAs<ServedTransform>;
-        return k;
-    }();
+    static const PluginKind kind = tableKind<T>(
+        BINOCLE_KIND_CLOUD_TRANSFORM, "transform", "transforms", PluginKind::InRig::List,
+        {{1, BINOCLE_END_OF(T, apply), "apply"}},
+        {{"apply", offsetof(T, apply), true, kApply}},
+        "this frame's cloud is dropped", &serveAs<ServedTransform>);
     return kind;
 }
 

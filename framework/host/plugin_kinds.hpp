@@ -69,10 +69,14 @@ struct PluginKind {
     const char *callName(uint32_t op) const;
 };
 
-// A descriptor with what every kind's table has: the header, its settings table, and
-// create, destroy and last_error (mandatory). The kind adds its versions and calls.
+// A kind's descriptor: what every kind's table has (the header, its settings table, and
+// create, destroy and last_error, mandatory), then the kind's own API versions and calls
+// (`calls`, appended to the entries), what a restart of its helper process costs a run
+// and its instance in the helper process.
 template <class Table>
-PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, PluginKind::InRig inRig) {
+PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, PluginKind::InRig inRig,
+                     std::vector<PluginKind::TableVersion> versions, const std::vector<PluginKind::Entry> &calls,
+                     const char *lostOnRestart, PluginKind::Serve serve) {
     PluginKind k;
     k.kind = kind;
     k.name = name;
@@ -81,9 +85,13 @@ PluginKind tableKind(int32_t kind, const char *name, const char *rigKey, PluginK
     k.tableSize = sizeof(Table);
     k.paramsOffset = offsetof(Table, params);
     k.paramCountOffset = offsetof(Table, param_count);
+    k.versions = std::move(versions);
     k.entries = {{"create", offsetof(Table, create), true, 0},
                  {"destroy", offsetof(Table, destroy), true, 0},
                  {"last_error", offsetof(Table, last_error), true, 0}};
+    k.entries.insert(k.entries.end(), calls.begin(), calls.end());
+    k.lostOnRestart = lostOnRestart;
+    k.serve = serve;
     return k;
 }
 

@@ -471,18 +471,16 @@ TriggerWorker::TriggerWorker(std::shared_ptr<Camera> camera) : camera_(std::move
 }
 
 TriggerWorker::~TriggerWorker() {
-    {
-        std::lock_guard<std::mutex> lock(mutex_);
-        stop_ = true;
-    }
-    cv_.notify_all();
+    wake(stop_);
     thread_.join();
 }
 
-void TriggerWorker::request() {
+void TriggerWorker::request() { wake(pending_); }
+
+void TriggerWorker::wake(bool &flag) {
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        pending_ = true;
+        flag = true;
     }
     cv_.notify_all();
 }

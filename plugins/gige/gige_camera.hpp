@@ -167,6 +167,8 @@ public:
 
 private:
     void loop();
+    // Sets `flag` (stop_ or pending_) under the lock and wakes the loop.
+    void wake(bool &flag);
     std::shared_ptr<Camera> camera_;
     std::mutex mutex_;
     std::condition_variable cv_;

@@ -35,14 +35,31 @@ struct Bytes {
         u32(static_cast<uint32_t>(s.size()));
         raw(s.data(), s.size());
     }
-    void map(const KeyValues &kv) {
+    // Fields with their size in bytes before them (4 bytes), written by `fill`.
+    template <class Fill>
+    void sized32(Fill fill) {
         const size_t at = b.size();
         u32(0);
-        for (const auto &[k, v] : kv) {
-            str(k);
-            str(v);
-        }
+        fill();
         patch32(at, static_cast<uint32_t>(b.size() - at - 4));
+    }
+    void map(const KeyValues &kv) {
+        sized32([&] {
+            for (const auto &[k, v] : kv) {
+                str(k);
+                str(v);
+            }
+        });
+    }
+    // Channel ids, each with a number: Statistics' message counts, Chunk Index's offsets.
+    template <class Pairs>
+    void channelMap(const Pairs &pairs) {
+        sized32([&] {
+            for (const auto &[channel, n] : pairs) {
+                u16(channel);
+                u64(n);
+            }
+        });
     }
     void patch32(size_t at, uint32_t v) {
         for (int i = 0; i < 4; ++i) b[at + i] = static_cast<uint8_t>(v >> (8 * i));

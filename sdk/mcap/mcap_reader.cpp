@@ -2,7 +2,7 @@
 // mcap::Reader: opens a file by its summary and chunk indexes, or scans its data section
 // when it has none (a file cut short, one written without indexes) and recovers every
 // complete chunk. Every size is checked against the file and the caps before allocating.
-#include "mcap_bytes.hpp"
+#include "mcap_records.hpp"
 
 #include <cerrno>
 #include <fcntl.h>
@@ -98,24 +98,12 @@ struct Reader::Impl {
 
     // ---- Records -------------------------------------------------------------------------
 
-    static Schema parseSchema(Cursor &c) {
-        Schema s;
-        s.id = c.u16("schema id");
-        s.name = c.str("schema name");
-        s.encoding = c.str("schema encoding");
-        const uint32_t n = c.u32("schema data length");
-        const uint8_t *d = c.run(n, "schema data");
-        s.data.assign(reinterpret_cast<const char *>(d), n);
-        return s;
-    }
-    static Channel parseChannel(Cursor &c) {
-        Channel ch;
-        ch.id = c.u16("channel id");
-        ch.schema_id = c.u16("channel schema_id");
-        ch.topic = c.str("channel topic");
-        ch.message_encoding = c.str("channel message_encoding");
-        ch.metadata = c.map("channel metadata");
-        return ch;
+    // A Schema or Channel record (its fields: mcap_records.hpp).
+    template <class Record>
+    static Record parse(Cursor &c) {
+        Record r;
+        detail::readFields(c, r);
+        return r;
     }
     void addSchema(Schema s, const std::string &where) {
         if (s.id == 0) throw Error(where + ": schema id 0 is reserved (no schema); expected 1 or more");
@@ -229,8 +217,8 @@ struct Reader::Impl {
             const uint8_t *b = h.run(len, "summary record");
             Cursor c(b, static_cast<size_t>(len), at(offset));
             switch (static_cast<Opcode>(op)) {
-            case Opcode::Schema: addSchema(parseSchema(c), at(offset)); break;
-            case Opcode::Channel: addChannel(parseChannel(c), at(offset)); break;
+            case Opcode::Schema: addSchema(parse<Schema>(c), at(offset)); break;
+            case Opcode::Channel: addChannel(parse<Channel>(c), at(offset)); break;
             case Opcode::Statistics: parseStatistics(c); haveStats = true; break;
             case Opcode::ChunkIndex: chunks.push_back(parseChunkIndex(c, offset)); break;
             case Opcode::MetadataIndex: readMetadata(c, offset); break;
@@ -254,22 +242,7 @@ struct Reader::Impl {
         return true;
     }
 
-    void parseStatistics(Cursor &c) {
-        stats.message_count = c.u64("message_count");
-        stats.schema_count = c.u16("schema_count");
-        stats.channel_count = c.u32("channel_count");
-        stats.attachment_count = c.u32("attachment_count");
-        stats.metadata_count = c.u32("metadata_count");
-        stats.chunk_count = c.u32("chunk_count");
-        stats.message_start_time = c.u64("message_start_time");
-        stats.message_end_time = c.u64("message_end_time");
-        const uint32_t n = c.u32("channel_message_counts length");
-        Cursor m(c.run(n, "channel_message_counts"), n, "statistics");
-        while (m.left() > 0) {
-            const uint16_t ch = m.u16("channel id");
-            stats.channel_message_counts[ch] = m.u64("message count");
-        }
-    }
+    void parseStatistics(Cursor &c) { detail::readFields(c, stats); }
 
     ChunkInfo parseChunkIndex(Cursor &c, uint64_t offset) {
         ChunkInfo k;
@@ -353,8 +326,8 @@ struct Reader::Impl {
                        op == static_cast<uint8_t>(Opcode::Message) || op == static_cast<uint8_t>(Opcode::Metadata)) {
                 const auto b = body(offset, len);
                 Cursor c(b.data(), b.size(), at(offset));
-                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parseSchema(c), at(offset));
-                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parseChannel(c), at(offset));
+                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parse<Schema>(c), at(offset));
+                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parse<Channel>(c), at(offset));
                 else if (op == static_cast<uint8_t>(Opcode::Metadata)) {
                     std::string name = c.str("name");
                     metadata.emplace_back(std::move(name), c.map("metadata"));
@@ -411,8 +384,8 @@ struct Reader::Impl {
             const auto records = load(index);
             walkChunk(*records, offset, [&](uint8_t op, Cursor &r, uint64_t recordOffset) {
                 const std::string where = at(offset) + " (Chunk), inner record at " + std::to_string(recordOffset);
-                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parseSchema(r), where);
-                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parseChannel(r), where);
+                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parse<Schema>(r), where);
+                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parse<Channel>(r), where);
                 else if (op == static_cast<uint8_t>(Opcode::Message)) countMessage(r, where);
             });
         } catch (...) {

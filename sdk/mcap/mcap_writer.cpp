@@ -2,7 +2,7 @@
 // mcap::Writer: chunked, compressed MCAP with message indexes, a summary with chunk
 // indexes and statistics, and a footer; each chunk whole on disk (and fsync'ed) before
 // the next one starts, so that a writer killed at any moment leaves a readable file.
-#include "mcap_bytes.hpp"
+#include "mcap_records.hpp"
 
 #include <cerrno>
 #include <fcntl.h>
@@ -59,23 +59,24 @@ struct Writer::Impl {
             throw Error(where() + ": fsync failed: " + std::strerror(errno), static_cast<int64_t>(offset));
     }
 
-    static void schemaRecord(Bytes &b, const Schema &s) {
-        const size_t at = b.begin(Opcode::Schema);
-        b.u16(s.id);
-        b.str(s.name);
-        b.str(s.encoding);
-        b.u32(static_cast<uint32_t>(s.data.size()));
-        b.raw(s.data.data(), s.data.size());
+    // A Schema, Channel or Statistics record (its fields: mcap_records.hpp).
+    template <class Record>
+    static void putRecord(Bytes &b, Opcode op, const Record &r) {
+        const size_t at = b.begin(op);
+        detail::putFields(b, r);
         b.end(at);
     }
-    static void channelRecord(Bytes &b, const Channel &c) {
-        const size_t at = b.begin(Opcode::Channel);
-        b.u16(c.id);
-        b.u16(c.schema_id);
-        b.str(c.topic);
-        b.str(c.message_encoding);
-        b.map(c.metadata);
-        b.end(at);
+
+    // A new schema or channel: written at once, before any chunk that uses it (a stream
+    // reader meets it first), kept for the summary and counted. Returns its id.
+    template <class Record, class Count>
+    uint16_t add(std::vector<Record> &kept, Opcode op, Record r, Count &count) {
+        Bytes b;
+        putRecord(b, op, r);
+        writeAll(b);
+        kept.push_back(std::move(r));
+        ++count;
+        return kept.back().id;
     }
 
     void flushChunk() {
@@ -121,13 +122,7 @@ struct Writer::Impl {
         chunkIndexes.u64(chunkEnd);
         chunkIndexes.u64(chunkOffset);
         chunkIndexes.u64(chunkLength);
-        const size_t mapAt = chunkIndexes.b.size();
-        chunkIndexes.u32(0);
-        for (const auto &[channel, o] : indexOffsets) {
-            chunkIndexes.u16(channel);
-            chunkIndexes.u64(o);
-        }
-        chunkIndexes.patch32(mapAt, static_cast<uint32_t>(chunkIndexes.b.size() - mapAt - 4));
+        chunkIndexes.channelMap(indexOffsets);
         chunkIndexes.u64(indexLength);
         chunkIndexes.str(compressionName(options.compression));
         chunkIndexes.u64(packed.size());
@@ -172,30 +167,12 @@ struct Writer::Impl {
             if (length > 0) groups.emplace_back(op, start, length);
         };
         group(Opcode::Schema, [&] {
-            for (const Schema &x : schemas) schemaRecord(s, x);
+            for (const Schema &x : schemas) putRecord(s, Opcode::Schema, x);
         });
         group(Opcode::Channel, [&] {
-            for (const Channel &x : channels) channelRecord(s, x);
+            for (const Channel &x : channels) putRecord(s, Opcode::Channel, x);
         });
-        group(Opcode::Statistics, [&] {
-            const size_t r = s.begin(Opcode::Statistics);
-            s.u64(stats.message_count);
-            s.u16(stats.schema_count);
-            s.u32(stats.channel_count);
-            s.u32(stats.attachment_count);
-            s.u32(stats.metadata_count);
-            s.u32(stats.chunk_count);
-            s.u64(stats.message_start_time);
-            s.u64(stats.message_end_time);
-            const size_t m = s.b.size();
-            s.u32(0);
-            for (const auto &[c, n] : stats.channel_message_counts) {
-                s.u16(c);
-                s.u64(n);
-            }
-            s.patch32(m, static_cast<uint32_t>(s.b.size() - m - 4));
-            s.end(r);
-        });
+        group(Opcode::Statistics, [&] { putRecord(s, Opcode::Statistics, stats); });
         if (options.chunk_indexes)
             group(Opcode::ChunkIndex, [&] { s.raw(chunkIndexes.b.data(), chunkIndexes.b.size()); });
         group(Opcode::MetadataIndex, [&] {
@@ -268,14 +245,9 @@ Writer::~Writer() {
 uint16_t Writer::addSchema(const std::string &name, const std::string &encoding, const std::string &data) {
     for (const Schema &s : impl_->schemas)
         if (s.name == name && s.encoding == encoding && s.data == data) return s.id;
-    Schema s{static_cast<uint16_t>(impl_->schemas.size() + 1), name, encoding, data};
-    // Written at once, before any chunk that uses it: a stream reader meets it first.
-    Bytes b;
-    Impl::schemaRecord(b, s);
-    impl_->writeAll(b);
-    impl_->schemas.push_back(std::move(s));
-    ++impl_->stats.schema_count;
-    return impl_->schemas.back().id;
+    return impl_->add(impl_->schemas, Opcode::Schema,
+                      Schema{static_cast<uint16_t>(impl_->schemas.size() + 1), name, encoding, data},
+                      impl_->stats.schema_count);
 }
 
 uint16_t Writer::addChannel(uint16_t schema_id, const std::string &topic, const std::string &message_encoding,
@@ -289,13 +261,9 @@ uint16_t Writer::addChannel(uint16_t schema_id, const std::string &topic, const 
                 throw Error(impl_->where() + ": topic '" + topic + "' was added before with another schema or encoding");
             return c.id;
         }
-    Channel c{static_cast<uint16_t>(impl_->channels.size()), schema_id, topic, message_encoding, metadata};
-    Bytes b;
-    Impl::channelRecord(b, c);
-    impl_->writeAll(b);
-    impl_->channels.push_back(std::move(c));
-    ++impl_->stats.channel_count;
-    return impl_->channels.back().id;
+    return impl_->add(impl_->channels, Opcode::Channel,
+                      Channel{static_cast<uint16_t>(impl_->channels.size()), schema_id, topic, message_encoding, metadata},
+                      impl_->stats.channel_count);
 }
 
 void Writer::write(uint16_t channel_id, uint32_t sequence, uint64_t log_time, uint64_t publish_time,

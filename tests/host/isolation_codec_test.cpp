@@ -262,13 +262,13 @@ TEST(IsolationCodec, TheKindsCallsRoundTrip) {
     wire::putGrabRequest(w, -1);
     wire::put(w, wire::AppliedCloud{12, BINOCLE_FRAME_CAMERA, 64, 0, 192});
     wire::Reader r(w.data());
-    const auto c = wire::getComputeRequest(r);
+    const auto c = wire::get<wire::ComputeRequest>(r);
     EXPECT_EQ(c.width, 640);
     EXPECT_EQ(c.height, 480);
     EXPECT_EQ(c.cv_type, 16);
     EXPECT_EQ(c.image_bytes, 4096u * 80);
     EXPECT_EQ(wire::getGrabRequest(r), -1);
-    const auto a = wire::getAppliedCloud(r);
+    const auto a = wire::get<wire::AppliedCloud>(r);
     EXPECT_EQ(a.count, 12);
     EXPECT_EQ(a.frame, BINOCLE_FRAME_CAMERA);
     EXPECT_EQ(a.xyz, 64u);
@@ -329,7 +329,7 @@ TEST(IsolationCodec, TruncatedMessagesAndPlanesOutsideTheRegionAreRefused) {
     wire::put(w, wire::ComputeRequest{1, 2, 3, 4});
     const std::string cut = w.data().substr(0, w.data().size() - 1);
     wire::Reader r(cut);
-    EXPECT_THROW(wire::getComputeRequest(r), Error);
+    EXPECT_THROW(wire::get<wire::ComputeRequest>(r), Error);
 
     StridedImage im(4, 4, 4, 0);
     wire::Layout layout;

@@ -522,56 +522,55 @@ Table tableOf(int32_t kind, const char *name, const char *version, const char *d
     return t;
 }
 
-template <class T>
-const binocle_source_api *sourceTable(const char *name, const char *version, const char *description) {
-    static const binocle_source_api table = [&] {
-        auto t = tableOf<binocle_source_api, T, SourceInstance<T>, binocle_source>(
-            BINOCLE_KIND_STEREO_SOURCE, name, version, description);
-        t.start = &sourceStart<T>;
-        t.stop = &sourceStop<T>;
-        t.grab = &sourceGrab<T>;
-        t.release_frame = &sourceRelease<T>;
-        t.calibration = &sourceCalibration<T>;
-        t.statistics = &sourceStatistics<T>;
-        t.enumerate_devices = &sourceEnumerate<T>;
+// The table of plugin class T, made once: tableOf()'s entries, then the kind's own,
+// which `calls` fills in.
+template <class Table, class T, class Wrapper, class Handle, class Calls>
+const Table *onceTable(int32_t kind, const char *name, const char *version, const char *description, Calls calls) {
+    static const Table table = [&] {
+        auto t = tableOf<Table, T, Wrapper, Handle>(kind, name, version, description);
+        calls(t);
         return t;
     }();
     return &table;
+}
+
+template <class T>
+const binocle_source_api *sourceTable(const char *name, const char *version, const char *description) {
+    return onceTable<binocle_source_api, T, SourceInstance<T>, binocle_source>(
+        BINOCLE_KIND_STEREO_SOURCE, name, version, description, [](binocle_source_api &t) {
+            t.start = &sourceStart<T>;
+            t.stop = &sourceStop<T>;
+            t.grab = &sourceGrab<T>;
+            t.release_frame = &sourceRelease<T>;
+            t.calibration = &sourceCalibration<T>;
+            t.statistics = &sourceStatistics<T>;
+            t.enumerate_devices = &sourceEnumerate<T>;
+        });
 }
 
 template <class T>
 const binocle_matcher_api *matcherTable(const char *name, const char *version, const char *description) {
-    static const binocle_matcher_api table = [&] {
-        auto t = tableOf<binocle_matcher_api, T, Instance<T>, binocle_matcher>(
-            BINOCLE_KIND_MATCHER, name, version, description);
-        t.compute = &matcherCompute<T>;
-        t.disparity_range = &matcherRange<T>;
-        return t;
-    }();
-    return &table;
+    return onceTable<binocle_matcher_api, T, Instance<T>, binocle_matcher>(
+        BINOCLE_KIND_MATCHER, name, version, description, [](binocle_matcher_api &t) {
+            t.compute = &matcherCompute<T>;
+            t.disparity_range = &matcherRange<T>;
+        });
 }
 
 template <class T>
 const binocle_cloud_transform_api *transformTable(const char *name, const char *version, const char *description) {
-    static const binocle_cloud_transform_api table = [&] {
-        auto t = tableOf<binocle_cloud_transform_api, T, Instance<T>, binocle_cloud_transform>(
-            BINOCLE_KIND_CLOUD_TRANSFORM, name, version, description);
-        t.apply = &transformApply<T>;
-        return t;
-    }();
-    return &table;
+    return onceTable<binocle_cloud_transform_api, T, Instance<T>, binocle_cloud_transform>(
+        BINOCLE_KIND_CLOUD_TRANSFORM, name, version, description,
+        [](binocle_cloud_transform_api &t) { t.apply = &transformApply<T>; });
 }
 
 template <class T>
 const binocle_evaluator_api *evaluatorTable(const char *name, const char *version, const char *description) {
-    static const binocle_evaluator_api table = [&] {
-        auto t = tableOf<binocle_evaluator_api, T, Instance<T>, binocle_evaluator>(
-            BINOCLE_KIND_EVALUATOR, name, version, description);
-        t.evaluate = &evaluatorEvaluate<T>;
-        t.finish = &evaluatorFinish<T>;
-        return t;
-    }();
-    return &table;
+    return onceTable<binocle_evaluator_api, T, Instance<T>, binocle_evaluator>(
+        BINOCLE_KIND_EVALUATOR, name, version, description, [](binocle_evaluator_api &t) {
+            t.evaluate = &evaluatorEvaluate<T>;
+            t.finish = &evaluatorFinish<T>;
+        });
 }
 
 } // namespace detail
