@@ -290,33 +290,19 @@ Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm
                       app.add_flag("--live", a.live, "pairs from the rig's source, taken when the board is still");
                       app.add_option("--out", a.out, "the calibration file (default: calib_<configuration>.yml here); an existing folder: that file in it")
                           ->type_name("FILE");
-                      app.add_option("--pairs-wanted", a.pairs_wanted, "stop after N good pairs (default 12 with --live, else all frames)")
-                          ->type_name("N")
-                          ->check(wholeNumber());
+                      addNumber(app, "--pairs-wanted", a.pairs_wanted, "stop after N good pairs (default 12 with --live, else all frames)", "N", wholeNumber());
                       addFramesOption(app, a.frames, "read at most N frames from the source");
-                      app.add_option("--still-frames", a.still_frames, "live: frames the board must be still (default 5)")
-                          ->type_name("N")
-                          ->check(atLeast(2));
-                      app.add_option("--still-px", a.still_px, "live: largest corner motion of a still board (default 1)")
-                          ->type_name("PX")
-                          ->check(positiveNumber());
-                      app.add_option("--pixel-pitch-um", a.pixel_pitch_um, "pixel pitch, for focal lengths in mm (default: the rig's pixel_pitch_um)")
-                          ->type_name("UM")
-                          ->check(positiveNumber());
-                      app.add_option("--min-board-percent", a.options.min_board_area_percent,
-                                     "reject boards covering less of the image (default 1.5)")
-                          ->type_name("A")
-                          ->check(decimalNumber());
-                      app.add_option("--max-edge-width-px", a.options.max_edge_width_px, "reject blurred boards, edges wider than W px (default 4)")
-                          ->type_name("W")
-                          ->check(decimalNumber());
-                      app.add_option("--max-pair-error-px", a.options.max_pair_error_px,
-                                     "drop pairs with a larger reprojection error and recalibrate (default 1)")
-                          ->type_name("E")
-                          ->check(decimalNumber());
-                      app.add_option("--min-pairs", a.options.min_pairs, "fewest good pairs to calibrate with (default 4)")
-                          ->type_name("N")
-                          ->check(atLeast(3));
+                      addNumber(app, "--still-frames", a.still_frames, "live: frames the board must be still (default 5)", "N", atLeast(2));
+                      addNumber(app, "--still-px", a.still_px, "live: largest corner motion of a still board (default 1)", "PX", positiveNumber());
+                      addNumber(app, "--pixel-pitch-um", a.pixel_pitch_um,
+                                "pixel pitch, for focal lengths in mm (default: the rig's pixel_pitch_um)", "UM", positiveNumber());
+                      addNumber(app, "--min-board-percent", a.options.min_board_area_percent,
+                                     "reject boards covering less of the image (default 1.5)", "A", decimalNumber());
+                      addNumber(app, "--max-edge-width-px", a.options.max_edge_width_px,
+                                "reject blurred boards, edges wider than W px (default 4)", "W", decimalNumber());
+                      addNumber(app, "--max-pair-error-px", a.options.max_pair_error_px,
+                                     "drop pairs with a larger reprojection error and recalibrate (default 1)", "E", decimalNumber());
+                      addNumber(app, "--min-pairs", a.options.min_pairs, "fewest good pairs to calibrate with (default 4)", "N", atLeast(3));
                       app.add_flag("--fix-intrinsic", a.options.fix_intrinsic, "keep each camera's own calibration in the stereo step");
                       app.add_flag("--fix-k3", a.options.fix_k3, "distortion k1, k2, p1, p2 only");
                   },

@@ -296,37 +296,25 @@ Register reg{{"design", "rank baselines and lenses for a target range or band by
                           ->type_name("MM,MM...");
                       app.add_option("--baselines", a.baselines, "baselines, mm: MIN:MAX:STEP or a list (default 100:200:10)")
                           ->type_name("SPEC");
-                      app.add_option("--pixel-pitch-um", a.head.pixel_pitch_um, "effective pixel pitch (default: the Videre head decimated by 4, 20.8)")
-                          ->type_name("UM")
-                          ->check(positiveNumber());
-                      app.add_option("--image-width", a.head.image_width_px, "image width in pixels (default 320)")->type_name("PX")->check(atLeast(1));
-                      app.add_option("--image-height", a.head.image_height_px, "image height in pixels (default 240)")->type_name("PX")->check(atLeast(1));
-                      app.add_option("--num-disparities", a.head.num_disparities, "the matcher's disparity search (default 64)")
-                          ->type_name("N")
-                          ->check(atLeast(1));
-                      app.add_option("--camera-height-mm", a.head.camera_height_mm, "camera height (default " + num(method::kDefaultCameraHeightMm) + ")")
-                          ->type_name("MM")
-                          ->check(decimalNumber());
-                      app.add_option("--inclination-deg", a.head.inclination_deg, "inclination (default 0)")
-                          ->type_name("DEG")
-                          ->check(decimalNumber())
+                      addNumber(app, "--pixel-pitch-um", a.head.pixel_pitch_um,
+                                "effective pixel pitch (default: the Videre head decimated by 4, 20.8)", "UM", positiveNumber());
+                      addNumber(app, "--image-width", a.head.image_width_px, "image width in pixels (default 320)", "PX", atLeast(1));
+                      addNumber(app, "--image-height", a.head.image_height_px, "image height in pixels (default 240)", "PX", atLeast(1));
+                      addNumber(app, "--num-disparities", a.head.num_disparities, "the matcher's disparity search (default 64)", "N", atLeast(1));
+                      addNumber(app, "--camera-height-mm", a.head.camera_height_mm,
+                                "camera height (default " + num(method::kDefaultCameraHeightMm) + ")", "MM", decimalNumber());
+                      addNumber(app, "--inclination-deg", a.head.inclination_deg, "inclination (default 0)", "DEG", decimalNumber())
                           ->check(CLI::Range(-89.0, 89.0));
-                      app.add_option("--panel-width-mm", a.panel_width_mm, "width of the object that must fit (default 2500)")
-                          ->type_name("MM")
-                          ->check(positiveNumber());
-                      app.add_option("--panel-height-mm", a.panel_height_mm, "height of the object that must fit (default 2000)")
-                          ->type_name("MM")
-                          ->check(positiveNumber());
-                      app.add_option("--top", a.top, "rows printed (default 10)")->type_name("N")->check(atLeast(1));
+                      addNumber(app, "--panel-width-mm", a.panel_width_mm, "width of the object that must fit (default 2500)", "MM", positiveNumber());
+                      addNumber(app, "--panel-height-mm", a.panel_height_mm, "height of the object that must fit (default 2000)", "MM", positiveNumber());
+                      addNumber(app, "--top", a.top, "rows printed (default 10)", "N", atLeast(1));
                       app.add_option("--predictors-from", a.predictors_from,
                                      "results.json whose predictors' rho chooses the ranking (default configs/predictors/e1-sim.json)")
                           ->type_name("FILE");
                       app.add_option("--predictor", a.predictor, "rank by this predictor instead of the one of highest rho")
                           ->type_name("NAME");
                       app.add_flag("--simulate", a.simulate, "measure η3D on the simulated rig for the best candidates");
-                      app.add_option("--simulate-count", a.simulate_count, "how many candidates to simulate (default 12)")
-                          ->type_name("N")
-                          ->check(atLeast(1));
+                      addNumber(app, "--simulate-count", a.simulate_count, "how many candidates to simulate (default 12)", "N", atLeast(1));
                       app.add_option("--rig", a.rig, "base rig for --simulate (default configs/rigs/sim-e1.yaml)")->type_name("FILE");
                       app.add_option("--out", a.out, "write design.json and design.csv (and simulated/ runs)")->type_name("DIR");
                       app.add_flag("--quiet", a.quiet, "no progress display");

@@ -112,6 +112,14 @@ CLI::Validator decimalNumber();          // any finite real (then e.g. CLI::Rang
 // Whole numbers >= min joined by `separator`, e.g. "2/8" for --shard.
 CLI::Validator wholeNumbers(char separator, long long min);
 
+// A numeric option: NAME VALUE into `value`, `type` naming the value in the help, read by
+// `number` (one of the validators above) before any other check the caller adds.
+template <class T>
+CLI::Option *addNumber(CLI::App &app, const std::string &name, T &value, const std::string &help,
+                       const std::string &type, const CLI::Validator &number) {
+    return app.add_option(name, value, help)->type_name(type)->check(number);
+}
+
 // A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
 // next to the executable, else from the source tree it was built from.
 std::string dataFile(const std::string &relative);
