@@ -5,6 +5,7 @@
 #include "core/atomic_file.hpp"
 #include "experiment/test_rig.hpp"
 #include "host/plugin_host.hpp"
+#include "host/plugin_kinds.hpp"
 #include "input/text.hpp"
 #include "method/statistics.hpp"
 
@@ -106,10 +107,13 @@ OJson software(const PluginHost &host, const YAML::Node &rig) {
     auto add = [&](const YAML::Node &block) {
         if (block.IsMap() && block["plugin"] && block["plugin"].IsScalar()) named.insert(block["plugin"].Scalar());
     };
-    for (const char *key : {"source", "matcher"}) add(rig[key]);
-    for (const char *key : {"transforms", "evaluators"})
-        if (rig[key] && rig[key].IsSequence())
-            for (const auto &b : rig[key]) add(b);
+    for (const PluginKind *k : pluginKinds()) {
+        const YAML::Node node = rig[k->rigKey];
+        if (!node) continue; // a kind the rig leaves out (an invalid node: no IsMap())
+        if (k->inRig != PluginKind::InRig::List) add(node);
+        else if (node.IsSequence())
+            for (const auto &b : node) add(b);
+    }
     OJson plugins = OJson::array();
     for (const auto &name : named) { // sorted by name
         const PluginRecord *p = host.find(name);

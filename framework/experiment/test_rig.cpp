@@ -5,6 +5,7 @@
 
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
+#include "host/plugin_kinds.hpp"
 #include "input/numbers.hpp"
 #include "input/yaml_file.hpp"
 
@@ -112,11 +113,9 @@ std::optional<double> settingDefault(const YAML::Node &rig, const std::string &p
     const auto dot = path.rfind('.');
     if (dot == std::string::npos) return std::nullopt;
     const std::string top = path.substr(0, path.find('.'));
-    const int32_t kind = top == "source"       ? BINOCLE_KIND_STEREO_SOURCE
-                         : top == "matcher"    ? BINOCLE_KIND_MATCHER
-                         : top == "transforms" ? BINOCLE_KIND_CLOUD_TRANSFORM
-                         : top == "evaluators" ? BINOCLE_KIND_EVALUATOR
-                                               : -1;
+    int32_t kind = -1; // the kind whose rig key `top` is
+    for (const PluginKind *k : pluginKinds())
+        if (top == k->rigKey) kind = k->kind;
     if (kind < 0) return std::nullopt;
     const auto table = settingsOf(nodeAt(rig, path.substr(0, dot)), kind, host);
     const auto *d = setting(table, path.substr(dot + 1));

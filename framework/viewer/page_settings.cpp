@@ -2,6 +2,8 @@
 // What a page may change, and where its paths may point.
 #include "viewer/page_settings.hpp"
 
+#include "host/plugin_kinds.hpp"
+
 #include <binocle/text.hpp>
 
 #include <algorithm>
@@ -29,9 +31,14 @@ bool inside(const fs::path &p, const fs::path &folder) {
 } // namespace
 
 std::vector<std::pair<const PluginBlock *, std::string>> pluginBlocks(const RigConfig &rig) {
-    std::vector<std::pair<const PluginBlock *, std::string>> out = {{&rig.source(), "source"}, {&rig.matcher(), "matcher"}};
-    for (size_t i = 0; i < rig.transforms().size(); ++i) out.emplace_back(&rig.transforms()[i], "transforms." + std::to_string(i));
-    for (size_t i = 0; i < rig.evaluators().size(); ++i) out.emplace_back(&rig.evaluators()[i], "evaluators." + std::to_string(i));
+    // Every kind's blocks, in kind order, as its descriptor holds them in a rig.
+    std::vector<std::pair<const PluginBlock *, std::string>> out;
+    for (const PluginKind *k : pluginKinds()) {
+        const auto &blocks = rig.blocks(k->kind);
+        for (size_t i = 0; i < blocks.size(); ++i)
+            out.emplace_back(&blocks[i], k->inRig == PluginKind::InRig::List ? std::string(k->rigKey) + "." + std::to_string(i)
+                                                                             : std::string(k->rigKey));
+    }
     return out;
 }
 
