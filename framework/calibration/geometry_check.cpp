@@ -19,8 +19,6 @@ std::string number(double v) {
     return s;
 }
 
-std::string sizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
-
 std::optional<double> numericSetting(const PluginBlock &block, const char *name) {
     const binocle_param *p = block.params.find(name);
     if (!p) return std::nullopt;

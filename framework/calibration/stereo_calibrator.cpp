@@ -21,8 +21,6 @@ std::string fixed(double v, int decimals) {
     return buf;
 }
 
-std::string sizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
-
 // The direction from the first corner to the last of the first row, and down the first
 // column: the detector may start from the opposite end in the other image.
 bool sameOrder(const std::vector<cv::Point2f> &l, const std::vector<cv::Point2f> &r, const BoardSpec &b) {

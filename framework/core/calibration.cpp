@@ -282,6 +282,8 @@ std::string StereoCalibration::toYaml() const {
 
 void StereoCalibration::save(const std::string &path) const { writeFileAtomic(path, toYaml()); }
 
+std::string sizeText(cv::Size size) { return std::to_string(size.width) + "x" + std::to_string(size.height); }
+
 StereoCalibration StereoCalibration::ideal(cv::Size size, double focal_length_px, double baseline_mm, double cx, double cy) {
     StereoCalibration c;
     c.image_size = size;

@@ -56,4 +56,7 @@ struct StereoCalibration {
                                    double cx = -1, double cy = -1);
 };
 
+// An image size as messages write it: "640x480" (width x height).
+std::string sizeText(cv::Size size);
+
 } // namespace binocle

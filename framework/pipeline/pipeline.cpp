@@ -218,10 +218,9 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
 void Pipeline::checkFrameSize(const LentFrame &frame, int64_t ordinal) const {
     const cv::Size left = frame.left().size(), right = frame.right().size();
     if (left == imageSize_ && right == imageSize_) return;
-    auto text = [](const cv::Size &z) { return std::to_string(z.width) + "x" + std::to_string(z.height); };
     throw Error("frame " + std::to_string(ordinal) + " (sequence " + std::to_string(frame.raw().sequence) + ") of source '" +
-                rig_.source().plugin + "': left image " + text(left) + ", right image " + text(right) + "; expected " +
-                text(imageSize_) + " as the frames before it and the calibration (" +
+                rig_.source().plugin + "': left image " + sizeText(left) + ", right image " + sizeText(right) + "; expected " +
+                sizeText(imageSize_) + " as the frames before it and the calibration (" +
                 (rig_.calibration_file ? *rig_.calibration_file : "published by the source") +
                 "): refusing to process it with the wrong geometry (did the source change its image size mid-run?)");
 }
