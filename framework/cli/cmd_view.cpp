@@ -75,9 +75,7 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
               "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
               defineOnRig<ViewArgs>(
                   [](CLI::App &app, ViewArgs &args) {
-                      app.add_option("--port", args.options.port, "TCP port (0: any free port)")
-                          ->type_name("N")
-                          ->check(wholeNumberIn(0, 65535))
+                      addNumber(app, "--port", args.options.port, "TCP port (0: any free port)", "N", wholeNumberIn(0, 65535))
                           ->capture_default_str();
                       app.add_option("--bind", args.options.address, "address to listen on (an IP address)")
                           ->type_name("ADDR")
@@ -88,19 +86,14 @@ Register reg{{"view", "a live web page of a rig: images, disparity, density view
                                      "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
                           ->type_name("NAME");
                       app.add_option("--out", args.options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
-                      app.add_option("--display-fps", args.options.display_fps,
-                                     "most frames per second sent to browsers (each gets no more than it can draw)")
-                          ->type_name("F")
-                          ->check(positiveNumber())
+                      addNumber(app, "--display-fps", args.options.display_fps,
+                                "most frames per second sent to browsers (each gets no more than it can draw)", "F", positiveNumber())
                           ->capture_default_str();
-                      app.add_option("--cloud-points", args.options.cloud_points, "most points drawn in the 3D view (thinned evenly)")
-                          ->type_name("N")
-                          ->check(atLeast(1))
+                      addNumber(app, "--cloud-points", args.options.cloud_points, "most points drawn in the 3D view (thinned evenly)", "N",
+                                atLeast(1))
                           ->capture_default_str();
-                      app.add_option("--cloud-fps", args.options.cloud_fps,
-                                     "most new clouds per second for the 3D view (the images come at --display-fps)")
-                          ->type_name("F")
-                          ->check(positiveNumber())
+                      addNumber(app, "--cloud-fps", args.options.cloud_fps,
+                                "most new clouds per second for the 3D view (the images come at --display-fps)", "F", positiveNumber())
                           ->capture_default_str();
                       addFramesOption(app, args.frames, "stop after N frames (measurements)");
                       app.add_flag("--paused", args.options.paused, "start paused on the first frame");
