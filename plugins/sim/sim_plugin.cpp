@@ -16,9 +16,11 @@
 
 #include <chrono>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 namespace binocle::plugins {
 
@@ -53,6 +55,17 @@ sim::Distortion distortionOf(const std::vector<double> &v) {
 }
 
 sim::Vec3 vec3Of(const std::vector<double> &v) { return {v[0], v[1], v[2]}; }
+
+// Settings copied as they are into the member of the same name (a key of the sim is the
+// name of the RigSettings or RenderSettings member it sets): one table, one loop.
+template <class Settings>
+void readWholeNumbers(const sdk::Params &p, Settings &s, std::initializer_list<std::pair<const char *, int Settings::*>> members) {
+    for (const auto &[key, member] : members) s.*member = static_cast<int>(p.integer(key));
+}
+template <class Settings>
+void readReals(const sdk::Params &p, Settings &s, std::initializer_list<std::pair<const char *, double Settings::*>> members) {
+    for (const auto &[key, member] : members) s.*member = p.real(key);
+}
 
 // Pixels of a rendered frame, kept alive until the host releases the frame.
 struct FramePixels {
@@ -107,14 +120,12 @@ public:
 
     SimSource(const sdk::Params &p, sdk::Host &host) : host_(host) {
         checkParameters(p, parameters(), "sim");
-        sim::RigSettings rig;
-        rig.image_width = static_cast<int>(p.integer("image_width"));
-        rig.image_height = static_cast<int>(p.integer("image_height"));
-        rig.pixel_pitch_um = p.real("pixel_pitch_um");
-        rig.focal_length_mm = p.real("focal_length_mm");
-        rig.baseline_mm = p.real("baseline_mm");
-        rig.camera_height_mm = p.real("camera_height_mm");
-        rig.inclination_deg = p.real("inclination_deg");
+        using Rig = sim::RigSettings;
+        Rig rig;
+        readWholeNumbers(p, rig, {{"image_width", &Rig::image_width}, {"image_height", &Rig::image_height}});
+        readReals(p, rig, {{"pixel_pitch_um", &Rig::pixel_pitch_um}, {"focal_length_mm", &Rig::focal_length_mm},
+                           {"baseline_mm", &Rig::baseline_mm}, {"camera_height_mm", &Rig::camera_height_mm},
+                           {"inclination_deg", &Rig::inclination_deg}});
         rig.distortion = distortionOf(numberList(p, "distortion", {4, 5}));
         const auto right = numberList(p, "distortion_right", {0, 4, 5});
         rig.distortion_right = right.empty() ? rig.distortion : distortionOf(right);
@@ -122,12 +133,11 @@ public:
         rig.right_offset_mm = vec3Of(numberList(p, "right_offset_mm", {3}));
         rig_.emplace(rig);
 
-        sim::RenderSettings render;
-        render.antialias = static_cast<int>(p.integer("antialias"));
-        render.binning = static_cast<int>(p.integer("binning"));
-        render.noise_sigma = p.real("noise_sigma");
-        render.gain_right = p.real("gain_right");
-        render.offset_right = p.real("offset_right");
+        using Render = sim::RenderSettings;
+        Render render;
+        readWholeNumbers(p, render, {{"antialias", &Render::antialias}, {"binning", &Render::binning}});
+        readReals(p, render, {{"noise_sigma", &Render::noise_sigma}, {"gain_right", &Render::gain_right},
+                              {"offset_right", &Render::offset_right}});
         render.color = p.string("color") == "bgr";
         render.seed = static_cast<uint32_t>(p.integer("seed"));
         renderer_.emplace(*rig_, render);
