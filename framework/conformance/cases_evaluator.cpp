@@ -50,37 +50,34 @@ std::vector<std::pair<std::string, double>> evaluated(const binocle_evaluator_ap
 } // namespace
 
 void evaluatorCases(Battery &b) {
-    auto api = reinterpret_cast<const binocle_evaluator_api *>(b.record.table);
-    const ParamValues &params = b.params;
-    b.run("create_destroy", [&] { return createDestroyCycles<binocle_evaluator_api, binocle_evaluator>(api, params); });
+    const Family<binocle_evaluator_api, binocle_evaluator> f(b);
+    const auto *api = f.api;
+    f.createDestroyCase();
     // An evaluator may refuse a synthetic frame (no calibration, no metadata): that is
     // fine when it says why with a code; the determinism case then has nothing to compare.
     auto evaluateOrRefusal = [&](binocle_evaluator *h, HostBlock &host, std::string &refusal) {
         try {
             return evaluated(api, h, host);
-        } catch (const CaseFailure &f) {
-            if (f.message.empty() || f.message[0] != '\x01') throw;
-            refusal = f.message.substr(1);
+        } catch (const CaseFailure &failure) {
+            if (failure.message.empty() || failure.message[0] != '\x01') throw;
+            refusal = failure.message.substr(1);
             return std::vector<std::pair<std::string, double>>{};
         }
     };
-    b.run("evaluate_in_host_buffers", [&] {
-        HostBlock host;
-        auto *h = createOrFail<binocle_evaluator_api, binocle_evaluator>(api, params, host);
+    f.instanceCase("evaluate_in_host_buffers", [&](binocle_evaluator *h, HostBlock &host) {
         std::string refusal;
         const auto figures = evaluateOrRefusal(h, host, refusal);
         if (api->finish) {
             const int32_t rc = api->finish(h);
             expectMessage("finish", rc, api->last_error(h));
         }
-        api->destroy(h);
         if (!refusal.empty()) return pass("refused the synthetic frame with a code: " + refusal);
         return pass(std::to_string(figures.size()) + " figures reported; inputs left untouched");
     });
     b.run("determinism", [&] {
         HostBlock ha, hb;
-        auto *a = createOrFail<binocle_evaluator_api, binocle_evaluator>(api, params, ha);
-        auto *c = createOrFail<binocle_evaluator_api, binocle_evaluator>(api, params, hb);
+        binocle_evaluator *a = f.create(ha);
+        binocle_evaluator *c = f.create(hb);
         std::string refusal;
         const auto f1 = evaluateOrRefusal(a, ha, refusal);
         if (!refusal.empty()) return skip("the synthetic frame is refused (" + refusal + ")");

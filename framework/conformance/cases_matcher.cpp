@@ -37,14 +37,12 @@ cv::Mat guardedCompute(const binocle_matcher_api *api, binocle_matcher *h, const
 } // namespace
 
 void matcherCases(Battery &b) {
-    auto api = reinterpret_cast<const binocle_matcher_api *>(b.record.table);
-    const ParamValues &params = b.params;
-    b.run("create_destroy", [&] { return createDestroyCycles<binocle_matcher_api, binocle_matcher>(api, params); });
-    b.run("compute_in_host_buffers", [&] {
+    const Family<binocle_matcher_api, binocle_matcher> f(b);
+    const auto *api = f.api;
+    f.createDestroyCase();
+    f.instanceCase("compute_in_host_buffers", [&](binocle_matcher *h, HostBlock &) {
         // Guard pages around every buffer; inputs read-only: a write to them, or past any
         // end, kills this case with SIGSEGV.
-        HostBlock host;
-        binocle_matcher *h = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, host);
         cv::Mat left, right;
         texturedPair(left, right, 320, 240, CV_8UC1);
         cv::Mat d = guardedCompute(api, h, left, right, BINOCLE_PIXEL_GRAY8);
@@ -56,12 +54,9 @@ void matcherCases(Battery &b) {
                 else if (v > 0) ++valid;
             }
         if (nonFinite) fail(std::to_string(nonFinite) + " disparities are not finite (write BINOCLE_INVALID_DISPARITY instead)");
-        api->destroy(h);
         return pass("GRAY8 320x240: " + std::to_string(valid) + " valid disparities, all writes inside the host's buffer");
     });
-    b.run("colour_formats", [&] {
-        HostBlock host;
-        binocle_matcher *h = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, host);
+    f.instanceCase("colour_formats", [&](binocle_matcher *h, HostBlock &) {
         std::string seen;
         for (int32_t format : {BINOCLE_PIXEL_BGR8, BINOCLE_PIXEL_RGB8}) {
             cv::Mat left, right;
@@ -78,13 +73,12 @@ void matcherCases(Battery &b) {
             expectMessage("compute", rc, api->last_error(h));
             seen += std::string(format == BINOCLE_PIXEL_BGR8 ? "BGR8 " : "RGB8 ") + (rc == BINOCLE_OK ? "ok" : resultName(rc)) + "; ";
         }
-        api->destroy(h);
         return pass(seen);
     });
     b.run("determinism", [&] {
         HostBlock ha, hb;
-        binocle_matcher *a = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, ha);
-        binocle_matcher *c = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, hb);
+        binocle_matcher *a = f.create(ha);
+        binocle_matcher *c = f.create(hb);
         cv::Mat left, right;
         texturedPair(left, right, 160, 120, CV_8UC1);
         const cv::Mat d1 = guardedCompute(api, a, left, right, BINOCLE_PIXEL_GRAY8);
@@ -96,11 +90,9 @@ void matcherCases(Battery &b) {
         api->destroy(c);
         return pass("same pair, same instance and a second instance: identical disparities");
     });
-    b.run("errors_as_codes", [&] {
+    f.instanceCase("errors_as_codes", [&](binocle_matcher *h, HostBlock &) {
         // Calls the host never makes: any answer will do but a crash, an exception or a
         // failure without a message.
-        HostBlock host;
-        binocle_matcher *h = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, host);
         std::string seen;
         for (int32_t format : {static_cast<int32_t>(BINOCLE_PIXEL_FLOAT32), static_cast<int32_t>(0x7777)}) {
             std::vector<float> l(64 * 48, 1.0f), r(64 * 48, 1.0f), d(64 * 48, 0.0f);
@@ -116,13 +108,12 @@ void matcherCases(Battery &b) {
         const int32_t rc = api->compute(h, &li, &li, &di);
         expectMessage("compute", rc, api->last_error(h));
         seen += std::string("1x1 pair: ") + resultName(rc);
-        api->destroy(h);
         return pass(seen);
     });
     b.run("disparity_range", [&] {
         if (!api->disparity_range) return skip("the table has no disparity_range entry");
         HostBlock host;
-        binocle_matcher *h = createOrFail<binocle_matcher_api, binocle_matcher>(api, params, host);
+        binocle_matcher *h = f.create(host);
         int32_t mn = -12345, num = -12345;
         const int32_t rc = api->disparity_range(h, &mn, &num);
         expectMessage("disparity_range", rc, api->last_error(h));

@@ -232,7 +232,8 @@ Outcome calibrationAndStatistics(const binocle_source_api *api, const ParamValue
 } // namespace
 
 void sourceCases(Battery &b) {
-    auto api = reinterpret_cast<const binocle_source_api *>(b.record.table);
+    const Family<binocle_source_api, binocle_source> f(b);
+    const auto *api = f.api;
     const ParamValues &params = b.params;
     b.cases.push_back(runCase("enumerate_devices", b.timeout_ms, [&] { return enumerateDevices(api, params); }));
     // Without a device, create fails: the cases that need an instance are skipped, saying so.
@@ -241,7 +242,7 @@ void sourceCases(Battery &b) {
     if (probe.status != Status::Passed) {
         b.skipAll = probe.status == Status::Skipped ? probe.message : "create failed";
     }
-    b.run("create_destroy", [&] { return createDestroyCycles<binocle_source_api, binocle_source>(api, params); });
+    f.createDestroyCase();
     b.run("grab_before_start", [&] { return grabBeforeStart(api, params); });
     b.run("lend_release_accounting", [&] { return lendReleaseAccounting(api, params); });
     b.run("release_from_another_thread", [&] { return releaseFromAnotherThread(api, params); });

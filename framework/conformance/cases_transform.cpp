@@ -3,7 +3,6 @@
 // cloud, determinism.
 #include "conformance/kit.hpp"
 
-
 namespace binocle::conformance {
 
 namespace {
@@ -25,31 +24,26 @@ std::vector<float> applied(const binocle_cloud_transform_api *api, binocle_cloud
 } // namespace
 
 void transformCases(Battery &b) {
-    auto api = reinterpret_cast<const binocle_cloud_transform_api *>(b.record.table);
-    const ParamValues &params = b.params;
-    b.run("create_destroy", [&] { return createDestroyCycles<binocle_cloud_transform_api, binocle_cloud_transform>(api, params); });
-    b.run("apply_in_host_buffers", [&] {
-        HostBlock host;
-        auto *h = createOrFail<binocle_cloud_transform_api, binocle_cloud_transform>(api, params, host);
+    using Transform = binocle_cloud_transform;
+    const Family<binocle_cloud_transform_api, Transform> f(b);
+    const auto *api = f.api;
+    f.createDestroyCase();
+    f.instanceCase("apply_in_host_buffers", [&](Transform *h, HostBlock &) {
         const auto pts = applied(api, h, 10000);
-        api->destroy(h);
         return pass(std::to_string(pts.size() / 3) + " of 10000 points kept; all writes inside the host's arrays");
     });
-    b.run("empty_cloud", [&] {
-        HostBlock host;
-        auto *h = createOrFail<binocle_cloud_transform_api, binocle_cloud_transform>(api, params, host);
+    f.instanceCase("empty_cloud", [&](Transform *h, HostBlock &) {
         binocle_cloud c{};
         c.frame = BINOCLE_FRAME_CAMERA;
         const int32_t rc = api->apply(h, &c);
         expectMessage("apply", rc, api->last_error(h));
         if (rc == BINOCLE_OK && c.count != 0) fail("apply grew an empty cloud to " + std::to_string(c.count) + " points");
-        api->destroy(h);
         return pass(std::string("empty cloud: ") + resultName(rc));
     });
     b.run("determinism", [&] {
         HostBlock ha, hb;
-        auto *a = createOrFail<binocle_cloud_transform_api, binocle_cloud_transform>(api, params, ha);
-        auto *c = createOrFail<binocle_cloud_transform_api, binocle_cloud_transform>(api, params, hb);
+        Transform *a = f.create(ha);
+        Transform *c = f.create(hb);
         const auto p1 = applied(api, a, 2000), p2 = applied(api, a, 2000), p3 = applied(api, c, 2000);
         if (p1 != p2) fail("two applies of the same cloud on one instance differ");
         if (p1 != p3) fail("two instances with the same settings give different clouds");

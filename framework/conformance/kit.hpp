@@ -128,4 +128,35 @@ Outcome createDestroyCycles(const Api *api, const ParamValues &params) {
     return pass(std::to_string(kCycles) + " create/destroy cycles, then two instances at once");
 }
 
+// A kind's family of cases on the plugin's table as `Api` (binocle_matcher_api ...), whose
+// instances are `Handle`s made with the battery's settings.
+template <class Api, class Handle>
+struct Family {
+    Battery &battery;
+    const Api *api;
+
+    explicit Family(Battery &b) : battery(b), api(reinterpret_cast<const Api *>(b.record.table)) {}
+
+    // An instance whose figures and texts land in `host`; a failed create fails the case.
+    Handle *create(HostBlock &host) const { return createOrFail<Api, Handle>(api, battery.params, host); }
+
+    // The create_destroy case (createDestroyCycles), which every family runs.
+    void createDestroyCase() const {
+        battery.run("create_destroy", [this] { return createDestroyCycles<Api, Handle>(api, battery.params); });
+    }
+
+    // A case on one new instance: `body(h, host)` gives the outcome, and the instance is
+    // destroyed once the body has returned (a failed case ends its child process as it is).
+    template <class Body>
+    void instanceCase(const std::string &name, Body body) const {
+        battery.run(name, [this, body] {
+            HostBlock host;
+            Handle *h = create(host);
+            Outcome outcome = body(h, host);
+            api->destroy(h);
+            return outcome;
+        });
+    }
+};
+
 } // namespace binocle::conformance
