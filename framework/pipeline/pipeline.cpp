@@ -15,6 +15,7 @@
 #include "core/json.hpp"
 #include "core/progress.hpp"
 #include "pipeline/frame_writer.hpp"
+#include "pipeline/plugin_instances.hpp"
 #include "pipeline/run_summary.hpp"
 #include "pipeline/stage_queue.hpp"
 #include "pipeline/stage_times.hpp"
@@ -77,13 +78,22 @@ std::pair<int32_t, int32_t> askDisparityRange(Matcher &m) {
 
 } // namespace
 
-Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig) {
-    source_ = std::make_unique<Source>(*rig.source().record, rig.source().params);
+Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig), instances_(std::make_unique<PluginInstances>()) {
+    // In the order they go back in reverse: the source last.
+    auto &sources = instances_->edit<Source>();
+    auto &matchers = instances_->edit<Matcher>();
+    auto &transforms = instances_->edit<CloudTransform>();
+    auto &evaluators = instances_->edit<EvaluatorSlot>();
+    sources.push_back(std::make_unique<Source>(*rig.source().record, rig.source().params));
     for (int i = 0; i < rig.runtime.matcher_instances; ++i)
-        matchers_.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
-    for (const auto &t : rig.transforms()) transforms_.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
-    for (const auto &e : rig.evaluators()) evaluators_.push_back(makeEvaluator(e));
-    disparityRange_ = askDisparityRange(*matchers_.front());
+        matchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
+    for (const auto &t : rig.transforms()) transforms.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
+    for (const auto &e : rig.evaluators()) evaluators.push_back(makeEvaluator(e));
+    disparityRange_ = askDisparityRange(*matchers.front());
+}
+
+Source &Pipeline::source() {
+    return *instances_->of<Source>().front();
 }
 
 std::string Pipeline::sourceStatistics() const {
@@ -92,7 +102,7 @@ std::string Pipeline::sourceStatistics() const {
 }
 
 void Pipeline::refreshSourceStatistics() {
-    std::string stats = source_->statistics();
+    std::string stats = source().statistics();
     std::lock_guard<std::mutex> lock(statisticsMutex_);
     sourceStatistics_ = std::move(stats);
 }
@@ -133,47 +143,50 @@ bool sameBlock(const PluginBlock &a, const PluginBlock &b) {
 
 void Pipeline::reconfigure(const RigConfig &rig) {
     // Everything new is created first: a refusal throws before anything is replaced.
-    std::unique_ptr<Source> source;
-    std::vector<std::unique_ptr<Matcher>> matchers;
-    std::vector<std::unique_ptr<CloudTransform>> transforms(rig.transforms().size());
-    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators(rig.evaluators().size());
+    std::unique_ptr<Source> nextSource;
+    std::vector<std::unique_ptr<Matcher>> nextMatchers;
+    std::vector<std::unique_ptr<CloudTransform>> nextTransforms(rig.transforms().size());
+    std::vector<std::unique_ptr<EvaluatorSlot>> nextEvaluators(rig.evaluators().size());
     const bool newSource = !sameBlock(rig.source(), rig_.source()) || rig.calibration_file != rig_.calibration_file;
-    if (newSource) source = std::make_unique<Source>(*rig.source().record, rig.source().params);
+    if (newSource) nextSource = std::make_unique<Source>(*rig.source().record, rig.source().params);
     // As many instances as the stage has threads (runtime.matcher_instances is read when
     // the pipeline is made).
+    const size_t matcherThreads = instances_->of<Matcher>().size();
     if (!sameBlock(rig.matcher(), rig_.matcher()))
-        for (size_t i = 0; i < matchers_.size(); ++i)
-            matchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
-    const std::pair<int32_t, int32_t> range = matchers.empty() ? disparityRange_ : askDisparityRange(*matchers.front());
+        for (size_t i = 0; i < matcherThreads; ++i)
+            nextMatchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
+    const std::pair<int32_t, int32_t> range = nextMatchers.empty() ? disparityRange_ : askDisparityRange(*nextMatchers.front());
     for (size_t i = 0; i < rig.transforms().size(); ++i)
         if (i >= rig_.transforms().size() || !sameBlock(rig.transforms()[i], rig_.transforms()[i]))
-            transforms[i] = std::make_unique<CloudTransform>(*rig.transforms()[i].record, rig.transforms()[i].params);
+            nextTransforms[i] = std::make_unique<CloudTransform>(*rig.transforms()[i].record, rig.transforms()[i].params);
     for (size_t i = 0; i < rig.evaluators().size(); ++i)
         if (i >= rig_.evaluators().size() || !sameBlock(rig.evaluators()[i], rig_.evaluators()[i]))
-            evaluators[i] = makeEvaluator(rig.evaluators()[i]);
-    if (source && sourceStarted_) {
+            nextEvaluators[i] = makeEvaluator(rig.evaluators()[i]);
+    if (nextSource && sourceStarted_) {
         // A camera is held by one instance at a time: the old one lets go first, and
         // takes the device back when the new one cannot start.
-        source_->stop();
+        source().stop();
         try {
-            source->start();
+            nextSource->start();
         } catch (...) {
-            source_->start();
+            source().start();
             throw;
         }
     }
-    if (source) {
-        source_ = std::move(source);
+    if (nextSource) {
+        instances_->edit<Source>().front() = std::move(nextSource);
         calibrationReady_ = false; // another source may publish another calibration
     }
-    if (!matchers.empty()) matchers_ = std::move(matchers);
+    if (!nextMatchers.empty()) instances_->edit<Matcher>() = std::move(nextMatchers);
     disparityRange_ = range;
-    for (size_t i = 0; i < transforms.size(); ++i)
-        if (!transforms[i]) transforms[i] = std::move(transforms_[i]);
-    transforms_ = std::move(transforms);
-    for (size_t i = 0; i < evaluators.size(); ++i)
-        if (!evaluators[i]) evaluators[i] = std::move(evaluators_[i]);
-    evaluators_ = std::move(evaluators);
+    auto &transforms = instances_->edit<CloudTransform>();
+    for (size_t i = 0; i < nextTransforms.size(); ++i)
+        if (!nextTransforms[i]) nextTransforms[i] = std::move(transforms[i]);
+    transforms = std::move(nextTransforms);
+    auto &evaluators = instances_->edit<EvaluatorSlot>();
+    for (size_t i = 0; i < nextEvaluators.size(); ++i)
+        if (!nextEvaluators[i]) nextEvaluators[i] = std::move(evaluators[i]);
+    evaluators = std::move(nextEvaluators);
     const int instances = rig_.runtime.matcher_instances;
     rig_ = rig;
     rig_.runtime.matcher_instances = instances;
@@ -186,7 +199,7 @@ void Pipeline::prepareCalibration(const cv::Size &imageSize) {
         calibration_ = StereoCalibration::load(*rig_.calibration_file);
         calibrationYaml_ = readTextFile(*rig_.calibration_file);
     } else {
-        calibrationYaml_ = source_->calibration();
+        calibrationYaml_ = source().calibration();
         if (calibrationYaml_.empty())
             throw Error(rig_.file + ": no calibration: the rig names no 'calibration:' file and source plugin '" +
                         rig_.source().plugin + "' publishes none (run `binocle calibrate`, or add calibration: FILE)");
@@ -239,13 +252,14 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     RunState s(options, static_cast<size_t>(rt.queue_depth), stageDepth);
     bool live = false;
     try {
-        live = sourceIsLive(source_->statistics());
+        live = sourceIsLive(source().statistics());
     } catch (const std::exception &) {
     }
     s.policy = rt.policy ? *rt.policy : live ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
-    const size_t jobs = matchers_.size() + 3 * stageDepth + 3;
+    const size_t matcherThreads = instances_->of<Matcher>().size();
+    const size_t jobs = matcherThreads + 3 * stageDepth + 3;
     for (size_t i = 0; i < jobs; ++i) s.pool.push_back(std::make_unique<Job>());
-    s.matched.setProducers(static_cast<int>(matchers_.size()));
+    s.matched.setProducers(static_cast<int>(matcherThreads));
     Json summary = runHeader(rig_, s.policy, live);
 
     const auto start = Clock::now();
@@ -258,7 +272,7 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     if (!s.aborted) {
         std::vector<std::thread> threads;
         threads.emplace_back([&] { acquire(s); });
-        for (size_t i = 0; i < matchers_.size(); ++i) threads.emplace_back([&, i] { rectifyAndMatch(s, i); });
+        for (size_t i = 0; i < matcherThreads; ++i) threads.emplace_back([&, i] { rectifyAndMatch(s, i); });
         threads.emplace_back([&] { cloudAndTransforms(s); });
         threads.emplace_back([&] { evaluate(s); });
         write(s, onFrame);
@@ -278,7 +292,7 @@ std::string Pipeline::finishSummary(RunState &s, Json &summary, double elapsed) 
     if (failure.empty()) {
         try {
             Json totals = Json::object();
-            for (auto &slot : evaluators_) {
+            for (const auto &slot : instances_->of<EvaluatorSlot>()) {
                 Json figures = Json::object();
                 slot->target = &figures;
                 slot->evaluator->finish();
@@ -292,7 +306,7 @@ std::string Pipeline::finishSummary(RunState &s, Json &summary, double elapsed) 
     }
     std::string stats;
     try {
-        stats = source_->statistics();
+        stats = source().statistics();
     } catch (const std::exception &e) {
         spdlog::warn("source statistics: {}", e.what());
     }
@@ -328,10 +342,12 @@ std::string Pipeline::finishSummary(RunState &s, Json &summary, double elapsed) 
         e["restarts"] = e.value("restarts", 0) + p.restarts();
         e["lost_calls"] = e.value("lost_calls", int64_t{0}) + p.lostCalls();
     };
-    isolated("source", *source_);
-    for (const auto &m : matchers_) isolated("matcher", *m);
-    for (size_t i = 0; i < transforms_.size(); ++i) isolated("transforms[" + std::to_string(i) + "]", *transforms_[i]);
-    for (size_t i = 0; i < evaluators_.size(); ++i) isolated("evaluators[" + std::to_string(i) + "]", *evaluators_[i]->evaluator);
+    isolated("source", source());
+    for (const auto &m : instances_->of<Matcher>()) isolated("matcher", *m);
+    const auto &transforms = instances_->of<CloudTransform>();
+    for (size_t i = 0; i < transforms.size(); ++i) isolated("transforms[" + std::to_string(i) + "]", *transforms[i]);
+    const auto &evaluators = instances_->of<EvaluatorSlot>();
+    for (size_t i = 0; i < evaluators.size(); ++i) isolated("evaluators[" + std::to_string(i) + "]", *evaluators[i]->evaluator);
     if (!isolation.empty()) summary["isolation"] = isolation;
     if (calibrationReady_) {
         summary["calibration"] = {{"baseline_mm", calibration_.baselineMm()},

@@ -21,6 +21,8 @@
 
 namespace binocle {
 
+class PluginInstances; // pipeline/plugin_instances.hpp, private to the pipeline
+
 struct RunOptions {
     int64_t max_frames = -1;   // frames taken from the source; < 0: until it ends
     std::string out_dir;       // empty: write nothing
@@ -126,7 +128,7 @@ public:
     const RigConfig &rig() const { return rig_; }
 
     const StereoCalibration &calibration() const { return calibration_; }
-    Source &source() { return *source_; }
+    Source &source();
 
 private:
     struct Job;
@@ -144,16 +146,10 @@ private:
     std::unique_ptr<EvaluatorSlot> makeEvaluator(const PluginBlock &block);
 
     RigConfig rig_;
-    std::unique_ptr<Source> source_;
-    std::vector<std::unique_ptr<Matcher>> matchers_; // runtime.matcher_instances of them
-    std::vector<std::unique_ptr<CloudTransform>> transforms_;
-    struct EvaluatorSlot {
-        std::string name;
-        std::unique_ptr<Evaluator> evaluator;
-        nlohmann::ordered_json *target = nullptr; // where its figures go right now
-        std::vector<std::pair<std::string, double>> *flat = nullptr;
-    };
-    std::vector<std::unique_ptr<EvaluatorSlot>> evaluators_;
+    // The plugin instances by wrapper type: one Source, runtime.matcher_instances
+    // Matchers, the rig's CloudTransforms and EvaluatorSlots (pipeline_run.hpp), and any
+    // other kind's, with no member here for each kind.
+    std::unique_ptr<PluginInstances> instances_;
     std::vector<FrameObserver *> observers_;
     bool sourceStarted_ = false;
     std::pair<int32_t, int32_t> disparityRange_{0, 0}; // asked of the matcher when it is made

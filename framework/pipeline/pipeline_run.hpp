@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Private to the pipeline: the state one run shares between its stage threads (pipeline.cpp
-// starts and ends the run; pipeline_stages.cpp is what each stage thread does).
+// starts and ends the run; pipeline_stages.cpp is what each stage thread does), and an
+// evaluator as the pipeline holds it.
 #pragma once
 
 #include "pipeline/pipeline.hpp"
 #include "pipeline/frame_writer.hpp"
+#include "pipeline/plugin_instances.hpp"
 #include "pipeline/stage_queue.hpp"
 #include "pipeline/stage_times.hpp"
 
@@ -23,6 +25,15 @@ using Clock = std::chrono::steady_clock;
 inline double secondsSince(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+
+// An evaluator and where its sink puts the figures of the call in progress (set around
+// each evaluate() and finish()).
+struct Pipeline::EvaluatorSlot {
+    std::string name;
+    std::unique_ptr<Evaluator> evaluator;
+    nlohmann::ordered_json *target = nullptr; // where its figures go right now
+    std::vector<std::pair<std::string, double>> *flat = nullptr;
+};
 
 // A frame on its way through the stages; its buffers are reused by later frames.
 struct Pipeline::Job {

@@ -51,7 +51,7 @@ void Pipeline::acquire(RunState &s) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
     };
     try {
-        source_->start();
+        source().start();
         sourceStarted_ = true;
         refreshSourceStatistics();
         auto lastStatistics = Clock::now();
@@ -74,7 +74,7 @@ void Pipeline::acquire(RunState &s) {
                 for (;;) {
                     const int32_t left = total < 0 ? 250 : std::max<int32_t>(1, total - static_cast<int32_t>(secondsSince(t0) * 1000));
                     try {
-                        frame = source_->grab(std::min<int32_t>(250, left));
+                        frame = source().grab(std::min<int32_t>(250, left));
                         break;
                     } catch (const PluginError &e) {
                         if (e.code() != BINOCLE_ERR_TIMEOUT || s.stopRequested() || s.aborted) throw;
@@ -148,7 +148,7 @@ void Pipeline::rectifyAndMatch(RunState &s, size_t instance) {
         if (!job->failed) {
             try {
                 // Read per frame: reconfigure() may have replaced it between frames.
-                Matcher &matcher = *matchers_[instance];
+                Matcher &matcher = *instances_->of<Matcher>()[instance];
                 const auto t0 = Clock::now();
                 const cv::Mat left = job->frame->left(), right = job->frame->right();
                 if (calibration_.rectified) {
@@ -184,7 +184,7 @@ void Pipeline::cloudAndTransforms(RunState &s) {
                 r.valid_pixel_ratio = static_cast<double>(valid) / static_cast<double>(r.disparity.total());
                 r.stage_seconds.emplace_back("cloud", secondsSince(t0));
                 const auto t1 = Clock::now();
-                for (auto &t : transforms_) {
+                for (const auto &t : instances_->of<CloudTransform>()) {
                     binocle_cloud view = r.cloud.view();
                     t->apply(view);
                     r.cloud.adopt(view);
@@ -210,8 +210,9 @@ void Pipeline::evaluate(RunState &s) {
         FrameResult &r = (*job)->r;
         r.metrics = Json::object();
         r.figures.clear();
-        if (!(*job)->failed && !s.aborted && evaluators_.empty()) r.stage_seconds.emplace_back("evaluators", 0.0);
-        if (!(*job)->failed && !s.aborted && !evaluators_.empty()) {
+        const auto &evaluators = instances_->of<EvaluatorSlot>();
+        if (!(*job)->failed && !s.aborted && evaluators.empty()) r.stage_seconds.emplace_back("evaluators", 0.0);
+        if (!(*job)->failed && !s.aborted && !evaluators.empty()) {
             try {
                 const auto t0 = Clock::now();
                 binocle_image rl{}, rr{}, d{};
@@ -239,7 +240,7 @@ void Pipeline::evaluate(RunState &s) {
                 in.min_disparity = disparityRange_.first;
                 in.num_disparities = disparityRange_.second;
                 putGroundPose(in, rig_);
-                for (auto &slot : evaluators_) {
+                for (const auto &slot : evaluators) {
                     Json figures = Json::object();
                     slot->target = &figures;
                     slot->flat = &r.figures;

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The stage pipeline with the fixture plugins: frame order behind parallel matchers,
 // the lossless and latest policies and their drop counts, frames.jsonl, a clean stop,
-// and a source outage ridden out with on_source_error: retry.
+// a source outage ridden out with on_source_error: retry, and the pipeline's instances
+// held by type.
 #include "common/test_util.hpp"
 #include "config/rig_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/plugin_instances.hpp"
 #include "pipeline/stage_times.hpp"
 
 #include <gtest/gtest.h>
@@ -295,6 +297,46 @@ TEST(StageTimes, AnEndlessRunKeepsABoundedUniformSample) {
     EXPECT_EQ(t.count(), n);
     EXPECT_NEAR(t.quantile(0.5), 0.5, 0.01);
     EXPECT_NEAR(t.quantile(0.95), 0.95, 0.01);
+}
+
+// Instances that write their name into a shared log when they go.
+struct LoggedInstance {
+    LoggedInstance(std::vector<std::string> &log, std::string name) : log_(log), name_(std::move(name)) {}
+    ~LoggedInstance() { log_.push_back(name_); }
+    std::vector<std::string> &log_;
+    std::string name_;
+};
+struct FirstKind : LoggedInstance {
+    using LoggedInstance::LoggedInstance;
+};
+struct SecondKind : LoggedInstance {
+    using LoggedInstance::LoggedInstance;
+};
+
+TEST(PluginInstances, EachTypeHasItsOwnListAndAnAbsentOneReadsEmpty) {
+    std::vector<std::string> log;
+    PluginInstances p;
+    EXPECT_TRUE(p.of<FirstKind>().empty());
+    p.edit<FirstKind>().push_back(std::make_unique<FirstKind>(log, "a"));
+    p.edit<FirstKind>().push_back(std::make_unique<FirstKind>(log, "b"));
+    EXPECT_EQ(&p.edit<FirstKind>(), &p.of<FirstKind>()); // made once
+    EXPECT_EQ(p.of<FirstKind>().size(), 2u);
+    EXPECT_EQ(p.of<FirstKind>()[1]->name_, "b");
+    EXPECT_TRUE(p.of<SecondKind>().empty()); // reading makes no list
+    p.edit<SecondKind>().push_back(std::make_unique<SecondKind>(log, "c"));
+    EXPECT_EQ(p.of<SecondKind>().size(), 1u);
+    EXPECT_EQ(p.of<FirstKind>().size(), 2u);
+    EXPECT_TRUE(log.empty());
+}
+
+TEST(PluginInstances, ListsGoInTheReverseOrderOfTheirMaking) {
+    std::vector<std::string> log;
+    {
+        PluginInstances p;
+        p.edit<FirstKind>().push_back(std::make_unique<FirstKind>(log, "first"));
+        p.edit<SecondKind>().push_back(std::make_unique<SecondKind>(log, "second"));
+    }
+    EXPECT_EQ(log, (std::vector<std::string>{"second", "first"}));
 }
 
 } // namespace
