@@ -199,10 +199,7 @@ void BM_PipelineVersusSerial(benchmark::State &state) {
 }
 BENCHMARK(BM_PipelineVersusSerial)
     ->ArgNames({"sgbm", "matchers"})
-    ->Args({0, 1})
-    ->Args({0, 2})
-    ->Args({1, 1})
-    ->Args({1, 2})
+    ->ArgsProduct({{0, 1}, {1, 2}}) // OpenCV SGBM or BM, one or two matchers: the four pairs
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);

@@ -134,21 +134,6 @@ private:
     std::shared_ptr<const LoadedRig> rig_;
 };
 
-py::dict pluginDict(const PluginRecord &p) {
-    py::dict d;
-    d["name"] = p.name;
-    d["kind"] = kindName(p.kind);
-    d["version"] = p.version;
-    d["abi_version"] = p.abi_version;
-    d["api_version"] = p.api_version;
-    d["description"] = p.description;
-    d["path"] = p.path;
-    py::list settings;
-    for (const binocle_param_desc &s : p.params()) settings.append(toPython(settingJson(s)));
-    d["settings"] = settings;
-    return d;
-}
-
 // What `binocle plugins` finds: the same search path and the same isolated scan.
 std::unique_ptr<PluginHost> scannedHost(const std::vector<std::string> &load, int64_t timeout_ms) {
     if (timeout_ms < 100) throw ArgumentError("timeout_ms=" + std::to_string(timeout_ms) + ": expected a whole number >= 100");
@@ -330,7 +315,7 @@ PYBIND11_MODULE(_binocle, m) {
         [](const std::vector<std::string> &load, int64_t timeout_ms) {
             const auto host = scannedHost(load, timeout_ms);
             py::list out;
-            for (const auto &p : host->plugins()) out.append(pluginDict(p));
+            for (const auto &p : host->plugins()) out.append(toPython(pluginJson(p)));
             return out;
         },
         py::arg("load") = std::vector<std::string>{}, py::arg("timeout_ms") = 5000,

@@ -87,4 +87,17 @@ nlohmann::ordered_json settingJson(const binocle_param_desc &d) {
     return p;
 }
 
+nlohmann::ordered_json pluginJson(const PluginRecord &p) {
+    nlohmann::ordered_json settings = nlohmann::ordered_json::array();
+    for (const binocle_param_desc &d : p.params()) settings.push_back(settingJson(d));
+    return {{"name", p.name},
+            {"kind", kindName(p.kind)},
+            {"version", p.version},
+            {"abi_version", p.abi_version},
+            {"api_version", p.api_version},
+            {"description", p.description},
+            {"path", p.path},
+            {"settings", std::move(settings)}};
+}
+
 } // namespace binocle
