@@ -38,6 +38,7 @@ struct Settings {
     int numDisparities = 64;
     int censusWidth = 9;
     int censusHeight = 7;
+    bool censusSymmetric = false; // centre-symmetric census: half the bits (sgm_kernels.hpp)
     int paths = 4;              // 4 (horizontal + vertical), 5 (one pass), 8
     int p1 = 10;
     int p2 = 120;

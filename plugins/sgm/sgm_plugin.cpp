@@ -43,6 +43,8 @@ public:
                 .help("width of the census window; width x height - 1 <= 64 bits (9 x 7, 11 x 5, 7 x 9 ...)"),
             Param::integer("census_height_px", "7").min(3).max(9).odd().unit("px")
                 .help("height of the census window"),
+            Param::choice("census", "full", "full|centre_symmetric")
+                .help("full: each neighbour against the centre (width x height - 1 bits); centre_symmetric: each pixel against its mirror image about the centre (half the bits, half the cost work)"),
             Param::choice("paths", "4", "4|5|8")
                 .help("aggregation paths: 8 (all), 4 (horizontal and vertical) or 5 (left, right and the three from above: one pass, no volume, least memory)"),
             Param::integer("p1", "10").min(1).max(253)
@@ -75,6 +77,7 @@ public:
         s.numDisparities = static_cast<int>(p.integer("num_disparities"));
         s.censusWidth = static_cast<int>(p.integer("census_width_px"));
         s.censusHeight = static_cast<int>(p.integer("census_height_px"));
+        s.censusSymmetric = p.string("census") == "centre_symmetric";
         s.paths = std::stoi(p.string("paths"));
         s.p1 = static_cast<int>(p.integer("p1"));
         s.p2 = static_cast<int>(p.integer("p2"));
@@ -85,7 +88,7 @@ public:
         s.medianPx = static_cast<int>(p.integer("median_px"));
         s.stripes = static_cast<int>(p.integer("stripes"));
         s.maxMemoryBytes = static_cast<double>(p.integer("max_memory_mb")) * 1048576.0;
-        const int bits = s.censusWidth * s.censusHeight - 1;
+        const int bits = sgm::censusBits(s.censusWidth, s.censusHeight, s.censusSymmetric);
         if (bits > 64)
             refuse("census window " + std::to_string(s.censusWidth) + " x " + std::to_string(s.censusHeight) + " = " +
                    std::to_string(bits) + " bits: expected census_width_px x census_height_px - 1 <= 64 (9 x 7, 11 x 5, 7 x 9)");
