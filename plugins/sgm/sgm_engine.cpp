@@ -110,7 +110,7 @@ void Engine::census(const cv::Mat &left, const cv::Mat &right) {
             const int y = isLeft ? i : i - height_;
             const cv::Mat &padded = isLeft ? paddedLeft_ : paddedRight_;
             for (int j = 0; j < settings_.censusHeight; ++j) rows[j] = padded.ptr<uint8_t>(y + j) + rx;
-            kernels_.censusRow(rows, width_, settings_.censusWidth, settings_.censusHeight,
+            kernels_.censusRow(rows, width_, settings_.censusWidth, settings_.censusHeight, settings_.censusSymmetric,
                                (isLeft ? censusLeft_ : censusRight_).data() + static_cast<size_t>(y) * width_);
         }
     });
@@ -121,8 +121,11 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
     uint8_t *volumeRow = twoPass_ && own ? costVolume_.data() + at * paddedDisp_ : nullptr;
     if (volumeRow && !down) return volumeRow; // computed by this stripe's pass down
     uint8_t *out = volumeRow ? volumeRow : s.cost.data();
-    kernels_.costRow(censusLeft_.data() + at, censusRight_.data() + at, width_, settings_.minDisparity,
-                     settings_.numDisparities, paddedDisp_, s.costScratch.data(), out);
+    // Words of at most 32 bits (the default centre-symmetric 9 x 7: 31) on 32-bit lanes.
+    const bool narrow = censusBits(settings_.censusWidth, settings_.censusHeight, settings_.censusSymmetric) <= 32;
+    const CostRowFn kernel = narrow ? kernels_.costRow32 : kernels_.costRow;
+    kernel(censusLeft_.data() + at, censusRight_.data() + at, width_, settings_.minDisparity, settings_.numDisparities,
+           paddedDisp_, s.costScratch.data(), out);
     return out;
 }
 

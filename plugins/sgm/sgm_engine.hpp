@@ -5,23 +5,45 @@
 
 #include "sgm_kernels.hpp"
 
+#include <cstddef>
 #include <cstdint>
+#include <new>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 namespace sgm {
 
+// Buffers on 64-byte boundaries (a cache line, one AVX-512 vector): the kernels' rows of
+// whole vectors then never straddle two lines (malloc aligns to 16 only).
+template <class T>
+struct CacheLineAllocator {
+    using value_type = T;
+    static constexpr std::align_val_t kAlign{64};
+    CacheLineAllocator() = default;
+    template <class U>
+    CacheLineAllocator(const CacheLineAllocator<U> &) {}
+    T *allocate(size_t n) { return static_cast<T *>(::operator new(n * sizeof(T), kAlign)); }
+    void deallocate(T *p, size_t) { ::operator delete(p, kAlign); }
+    template <class U>
+    bool operator==(const CacheLineAllocator<U> &) const { return true; }
+    template <class U>
+    bool operator!=(const CacheLineAllocator<U> &) const { return false; }
+};
+template <class T>
+using AlignedVector = std::vector<T, CacheLineAllocator<T>>;
+
 struct Settings {
     int minDisparity = 0;
     int numDisparities = 64;
     int censusWidth = 9;
     int censusHeight = 7;
+    bool censusSymmetric = true; // centre-symmetric census: half the bits (sgm_kernels.hpp)
     int paths = 4;              // 4 (horizontal + vertical), 5 (one pass), 8
-    int p1 = 10;
-    int p2 = 120;
+    int p1 = 6;
+    int p2 = 90;
     int p2IntensityStep = 30;   // 0: P2 constant; else P2 * s / (s + |intensity step|), >= p1
-    int uniquenessPercent = 8;
+    int uniquenessPercent = 6;
     int disp12MaxDiff = 1;      // -1: no left-right check
     bool subpixel = true;
     int medianPx = 5;           // 1: none
@@ -55,9 +77,9 @@ public:
 
 private:
     struct Stripe {
-        std::vector<uint8_t> cost, pathRows, pathMins, horizontal;
-        std::vector<uint16_t> scratchSum;
-        std::vector<uint64_t> costScratch;
+        AlignedVector<uint8_t> cost, pathRows, pathMins, horizontal;
+        AlignedVector<uint16_t> scratchSum;
+        AlignedVector<uint64_t> costScratch;
         std::vector<int16_t> best;
         std::vector<uint16_t> bestSum;
         std::vector<uint32_t> rightKey; // the left-right check's (sum, d) per right column
@@ -89,10 +111,10 @@ private:
     uint8_t p2ByStep_[511]; // P2 by intensity step -255..255 (PathParams::p2ByStep)
     cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
     std::vector<cv::Mat> bandOut_; // per band of the median: its filtered rows
-    std::vector<uint64_t> censusLeft_, censusRight_;
-    std::vector<uint16_t> volume_;  // 8 paths: the pass down's sums
-    std::vector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
-    std::vector<uint8_t> costVolume_; // and its costs, which the pass up reads again
+    AlignedVector<uint64_t> censusLeft_, censusRight_;
+    AlignedVector<uint16_t> volume_;  // 8 paths: the pass down's sums
+    AlignedVector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
+    AlignedVector<uint8_t> costVolume_; // and its costs, which the pass up reads again
     std::vector<Stripe> stripes_;
     int allocations_ = 0;
 };

@@ -43,9 +43,15 @@ static inline size_t horizontalScratch(int width, int paddedDisp) {
 
 // Census bits of one row. rows[j] points at image column 0 of the grey row y + j - ch/2 of
 // an image padded by cw/2 columns on each side (so rows[j][x + dx] is readable for
-// |dx| <= cw/2). Bit k of out[x] is set when neighbour k (row-major order in the cw x ch
-// window, the centre skipped) is darker than the centre.
-using CensusRowFn = void (*)(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out);
+// |dx| <= cw/2). Full census (symmetric false): bit k of out[x] is set when neighbour k
+// (row-major order in the cw x ch window, the centre skipped) is darker than the centre:
+// cw * ch - 1 bits. Centre-symmetric census (symmetric true; Spangenberg et al. 2013):
+// bit k is set when window pixel k (row-major, k before the centre) is darker than its
+// mirror image about the centre, window pixel cw * ch - 1 - k: (cw * ch - 1) / 2 bits.
+using CensusRowFn = void (*)(const uint8_t *const *rows, int width, int cw, int ch, bool symmetric, uint64_t *out);
+static inline int censusBits(int cw, int ch, bool symmetric) {
+    return symmetric ? (cw * ch - 1) / 2 : cw * ch - 1;
+}
 
 // Words of scratch costRow needs (the right census row rearranged for vector loads).
 using CostScratchFn = size_t (*)(int width, int minDisparity, int paddedDisp);
@@ -54,6 +60,9 @@ using CostScratchFn = size_t (*)(int width, int minDisparity, int paddedDisp);
 // kCostInvalid where x - minD - d < 0 or d >= numDisp.
 using CostRowFn = void (*)(const uint64_t *left, const uint64_t *right, int width, int minDisparity, int numDisp,
                            int paddedDisp, uint64_t *scratch, uint8_t *cost);
+// Words of census below 2^32 (a window of at most 32 bits) may take costRow32 instead: the
+// same costs, counted on 32-bit lanes (twice the candidates a vector, half the popcounts);
+// the same scratch.
 
 // What one path direction needs besides the costs.
 struct PathParams {
@@ -128,6 +137,7 @@ struct Kernels {
     CensusRowFn censusRow;
     CostScratchFn costScratchWords;
     CostRowFn costRow;
+    CostRowFn costRow32; // census words < 2^32 only
     PathRowFn pathRow;
     HorizontalRowFn horizontalRow;
     HorizontalRowsFn horizontalRows;

@@ -14,8 +14,21 @@ namespace {
 inline uint8_t addSat(int a, int b) { return static_cast<uint8_t>(std::min(255, a + b)); }
 inline uint8_t subSat(int a, int b) { return static_cast<uint8_t>(std::max(0, a - b)); }
 
-void censusRowScalar(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
+void censusRowScalar(const uint8_t *const *rows, int width, int cw, int ch, bool symmetric, uint64_t *out) {
     const int rx = cw / 2, ry = ch / 2;
+    if (symmetric) {
+        const int bits = censusBits(cw, ch, true), last = cw * ch - 1;
+        for (int x = 0; x < width; ++x) {
+            uint64_t word = 0;
+            for (int k = 0; k < bits; ++k) {
+                const int mirror = last - k;
+                const uint8_t a = rows[k / cw][x + k % cw - rx], b = rows[mirror / cw][x + mirror % cw - rx];
+                word |= static_cast<uint64_t>(a < b) << k;
+            }
+            out[x] = word;
+        }
+        return;
+    }
     for (int x = 0; x < width; ++x) {
         const uint8_t centre = rows[ry][x];
         uint64_t bits = 0;
@@ -159,7 +172,7 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
 } // namespace
 
 const Kernels &scalarKernels() {
-    static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar,
+    static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar, costRowScalar,
                            pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
                            upWtaRowScalar};
     return k;

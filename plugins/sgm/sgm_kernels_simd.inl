@@ -111,18 +111,25 @@ inline int leastWord(const v_uint16 &a) {
 // the highest bit down: doubling it and subtracting the mask (all ones = -1) shifts the
 // next bit in, with no read-modify-write of memory between two neighbours.
 // CW, CH: the window when known at compile time (the default 9 x 7: the loops unroll and
-// every neighbour's row and column become constants), 0 when not.
-template <int CW, int CH>
+// every neighbour's row and column become constants), 0 when not. Sym: the centre-
+// symmetric census (bit k: window pixel k darker than its mirror, pixel cw * ch - 1 - k),
+// else the full one (neighbour k, the centre skipped, darker than the centre).
+template <int CW, int CH, bool Sym>
 void censusRowOf(const uint8_t *const *rows, int width, int runtimeCw, int runtimeCh, uint64_t *out) {
     const int cw = CW > 0 ? CW : runtimeCw, ch = CH > 0 ? CH : runtimeCh;
-    const int rx = cw / 2, ry = ch / 2, count = cw * ch - 1;
-    // Neighbour k: its row and its column offset, in the order of the bits.
-    const uint8_t *row[64];
-    int offset[64];
+    const int rx = cw / 2, ry = ch / 2, count = censusBits(cw, ch, Sym), last = cw * ch - 1;
+    // Window pixel n of bit k (the centre skipped, full census) and, for Sym, its mirror.
+    auto pixelOf = [&](int k) { return Sym || k < ry * cw + rx ? k : k + 1; };
+    // Neighbour k: its row and its column offset, in the order of the bits; for Sym the
+    // mirror's too.
+    const uint8_t *row[64], *mirrorRow[64];
+    int offset[64], mirrorOffset[64];
     for (int k = 0; k < count; ++k) {
-        const int n = k < ry * cw + rx ? k : k + 1; // the centre skipped
+        const int n = pixelOf(k), m = last - k;
         row[k] = rows[n / cw];
         offset[k] = n % cw - rx;
+        mirrorRow[k] = rows[m / cw];
+        mirrorOffset[k] = m % cw - rx;
     }
     int x = 0;
     for (; x + kLanes8 <= width; x += kLanes8) {
@@ -135,10 +142,11 @@ void censusRowOf(const uint8_t *const *rows, int width, int runtimeCw, int runti
             for (int i = 7; i >= 0; --i) {
                 const int k = 8 * b + i;
                 if (k >= count) continue;
-                const uint8_t *at = CW > 0 ? rows[(k < ry * cw + rx ? k : k + 1) / cw] +
-                                                 ((k < ry * cw + rx ? k : k + 1) % cw - rx)
-                                           : row[k] + offset[k];
-                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(at + x) < centre));
+                const uint8_t *at = CW > 0 ? rows[pixelOf(k) / cw] + (pixelOf(k) % cw - rx) : row[k] + offset[k];
+                const v_uint8 other = !Sym ? centre
+                                      : vx_load((CW > 0 ? rows[(last - k) / cw] + ((last - k) % cw - rx)
+                                                        : mirrorRow[k] + mirrorOffset[k]) + x);
+                p = v_sub_wrap(v_add_wrap(p, p), v_reinterpret_as_u8(vx_load(at + x) < other));
             }
             plane[b] = p;
         }
@@ -159,22 +167,24 @@ void censusRowOf(const uint8_t *const *rows, int width, int runtimeCw, int runti
     }
     // The last pixels of a row that is not a whole number of vectors.
     for (; x < width; ++x) {
-        const uint8_t centre = rows[ry][x];
         uint64_t bits = 0;
-        int k = 0;
-        for (int j = 0; j < ch; ++j)
-            for (int dx = -rx; dx <= rx; ++dx) {
-                if (j == ry && dx == 0) continue;
-                bits |= static_cast<uint64_t>(rows[j][x + dx] < centre) << k;
-                ++k;
-            }
+        for (int k = 0; k < count; ++k) {
+            const int n = pixelOf(k), m = Sym ? last - k : ry * cw + rx;
+            bits |= static_cast<uint64_t>(rows[n / cw][x + n % cw - rx] < rows[m / cw][x + m % cw - rx]) << k;
+        }
         out[x] = bits;
     }
 }
 
-void censusRow(const uint8_t *const *rows, int width, int cw, int ch, uint64_t *out) {
-    if (cw == 9 && ch == 7) censusRowOf<9, 7>(rows, width, cw, ch, out);
-    else censusRowOf<0, 0>(rows, width, cw, ch, out);
+void censusRow(const uint8_t *const *rows, int width, int cw, int ch, bool symmetric, uint64_t *out) {
+    if (cw == 9 && ch == 7) {
+        if (symmetric) censusRowOf<9, 7, true>(rows, width, cw, ch, out);
+        else censusRowOf<9, 7, false>(rows, width, cw, ch, out);
+    } else if (symmetric) {
+        censusRowOf<0, 0, true>(rows, width, cw, ch, out);
+    } else {
+        censusRowOf<0, 0, false>(rows, width, cw, ch, out);
+    }
 }
 
 // ---- costs ----------------------------------------------------------------------------
@@ -195,10 +205,11 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
     const size_t words = planeWords(width, minD, paddedDisp);
     for (int s = 0; s < 8; ++s) {
         uint64_t *plane = scratch + s * words;
-        for (size_t q = 0; q < words; ++q) {
-            const size_t j = 8 * q + s;
-            plane[q] = j < static_cast<size_t>(width) ? right[width - 1 - j] : 0;
-        }
+        // Words of the row (no test a word), then zeros.
+        const size_t inside = width > s ? static_cast<size_t>(width - s + 7) / 8 : 0;
+        const uint64_t *from = right + width - 1 - s;
+        for (size_t q = 0; q < inside; ++q) plane[q] = from[-8 * static_cast<ptrdiff_t>(q)];
+        for (size_t q = inside; q < words; ++q) plane[q] = 0;
     }
     // planes[s]: plane s mod 8, one word further on for s >= 8.
     const uint64_t *planes[16];
@@ -224,6 +235,58 @@ void costRow(const uint64_t *left, const uint64_t *right, int width, int minD, i
                                 v_shl<16>(popcount64(vx_load(p[6] + q) ^ centre)) |
                                 v_shl<24>(popcount64(vx_load(p[7] + q) ^ centre));
             v_uint8 c = v_reinterpret_as_u8(w0 | v_shl<32>(w1));
+            const int lanes = valid - d0;
+            if (lanes < kLanes8) c = v_select(iota < vx_setall_u8(static_cast<uint8_t>(lanes > 0 ? lanes : 0)), c, invalid);
+            v_store(out + d0, c);
+        }
+    }
+}
+
+// The same for census words below 2^32, on 32-bit lanes: the reversed row split by
+// residue mod 4 (plane s holds rev[4q + s]), four planes of 32-bit words; one load of
+// plane (r + k) mod 4 gives candidates d = 4i + k (lane i), and the four planes' costs,
+// shifted by 8k bits, fill the bytes in order: half the loads and popcounts a candidate.
+inline v_uint32 popcount32(const v_uint32 &a) {
+#if CV_SIMD_WIDTH == 64 && CV_AVX_512VPOPCNTDQ
+    return v_uint32(_mm512_popcnt_epi32(a.val));
+#else
+    return v_popcount(a);
+#endif
+}
+
+void costRow32(const uint64_t *left, const uint64_t *right, int width, int minD, int numDisp, int paddedDisp,
+               uint64_t *scratch64, uint8_t *cost) {
+    constexpr int kLanes32 = v_uint32::nlanes;
+    // Words of a plane: as planeWords for 8 planes of 64-bit words, which bounds these.
+    const size_t words = static_cast<size_t>((width + minD + paddedDisp + 4) / 4 + kLanes32 + 2);
+    uint32_t *scratch = reinterpret_cast<uint32_t *>(scratch64);
+    for (int s = 0; s < 4; ++s) {
+        uint32_t *plane = scratch + s * words;
+        // Words of the row (no test a word), then zeros.
+        const size_t inside = width > s ? static_cast<size_t>(width - s + 3) / 4 : 0;
+        const uint64_t *from = right + width - 1 - s;
+        for (size_t q = 0; q < inside; ++q) plane[q] = static_cast<uint32_t>(from[-4 * static_cast<ptrdiff_t>(q)]);
+        for (size_t q = inside; q < words; ++q) plane[q] = 0;
+    }
+    // planes[s]: plane s mod 4, one word further on for s >= 4.
+    const uint32_t *planes[8];
+    for (int s = 0; s < 8; ++s) planes[s] = scratch + (s & 3) * words + (s >> 2);
+    alignas(64) uint8_t iotaBytes[kLanes8];
+    for (int i = 0; i < kLanes8; ++i) iotaBytes[i] = static_cast<uint8_t>(i);
+    const v_uint8 iota = vx_load_aligned(iotaBytes);
+    const v_uint8 invalid = vx_setall_u8(kCostInvalid);
+    for (int x = 0; x < width; ++x) {
+        const v_uint32 centre = vx_setall_u32(static_cast<uint32_t>(left[x]));
+        const int base = width - 1 - x + minD;
+        const int valid = std::min(numDisp, x - minD + 1);
+        uint8_t *out = cost + static_cast<size_t>(x) * paddedDisp;
+        for (int d0 = 0; d0 < paddedDisp; d0 += kLanes8) {
+            const int at = base + d0, q = at >> 2;
+            const uint32_t *const *p = planes + (at & 3);
+            const v_uint32 w = popcount32(vx_load(p[0] + q) ^ centre) | v_shl<8>(popcount32(vx_load(p[1] + q) ^ centre)) |
+                               v_shl<16>(popcount32(vx_load(p[2] + q) ^ centre)) |
+                               v_shl<24>(popcount32(vx_load(p[3] + q) ^ centre));
+            v_uint8 c = v_reinterpret_as_u8(w);
             const int lanes = valid - d0;
             if (lanes < kLanes8) c = v_select(iota < vx_setall_u8(static_cast<uint8_t>(lanes > 0 ? lanes : 0)), c, invalid);
             v_store(out + d0, c);
@@ -547,7 +610,7 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
+    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, costRow32, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
     return k;
 }
 

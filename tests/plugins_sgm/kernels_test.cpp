@@ -51,11 +51,25 @@ TEST_P(SimdKernels, CensusEqualsTheReference) {
             padded(cv::Rect(0, 0, std::min(3, padded.cols), ch)).setTo(7);
             std::vector<const uint8_t *> rows(static_cast<size_t>(ch));
             for (int j = 0; j < ch; ++j) rows[static_cast<size_t>(j)] = padded.ptr<uint8_t>(j) + cw / 2;
-            std::vector<uint64_t> a(static_cast<size_t>(width), 1), b(static_cast<size_t>(width), 2);
-            ref().censusRow(rows.data(), width, cw, ch, a.data());
-            simd().censusRow(rows.data(), width, cw, ch, b.data());
-            ASSERT_EQ(a, b) << "width " << width << ", window " << cw << "x" << ch;
+            for (bool symmetric : {false, true}) {
+                std::vector<uint64_t> a(static_cast<size_t>(width), 1), b(static_cast<size_t>(width), 2);
+                ref().censusRow(rows.data(), width, cw, ch, symmetric, a.data());
+                simd().censusRow(rows.data(), width, cw, ch, symmetric, b.data());
+                ASSERT_EQ(a, b) << "width " << width << ", window " << cw << "x" << ch << (symmetric ? ", centre-symmetric" : "");
+                if (symmetric)
+                    for (uint64_t word : a) ASSERT_EQ(word >> sgm::censusBits(cw, ch, true), 0u);
+            }
         }
+}
+
+TEST(CentreSymmetricCensus, ComparesEachPixelWithItsMirror) {
+    // A 3 x 3 window, pixels 0..8 row-major: bit k compares pixel k with pixel 8 - k.
+    const uint8_t r0[] = {1, 9, 5}, r1[] = {4, 0, 3}, r2[] = {2, 6, 8};
+    const uint8_t *rows[] = {r0 + 1, r1 + 1, r2 + 1};
+    uint64_t word = 0;
+    sgm::scalarKernels().censusRow(rows, 1, 3, 3, true, &word);
+    // 1 < 8, 9 < 6 no, 5 < 2 no, 4 < 3 no.
+    EXPECT_EQ(word, 0b0001u);
 }
 
 TEST_P(SimdKernels, CostsEqualTheReference) {
@@ -71,6 +85,13 @@ TEST_P(SimdKernels, CostsEqualTheReference) {
                 ref().costRow(left.data(), right.data(), width, minD, numDisp, dp, nullptr, a.data());
                 simd().costRow(left.data(), right.data(), width, minD, numDisp, dp, scratch.data(), b.data());
                 ASSERT_EQ(a, b) << "width " << width << ", min_disparity " << minD << ", num_disparities " << numDisp;
+                // Words below 2^32 (windows of at most 32 bits) through the 32-bit kernel.
+                for (auto &v : left) v &= 0xFFFFFFFFu;
+                for (auto &v : right) v &= 0xFFFFFFFFu;
+                ref().costRow(left.data(), right.data(), width, minD, numDisp, dp, nullptr, a.data());
+                simd().costRow32(left.data(), right.data(), width, minD, numDisp, dp, scratch.data(), b.data());
+                ASSERT_EQ(a, b) << "32-bit words, width " << width << ", min_disparity " << minD << ", num_disparities "
+                                << numDisp;
             }
 }
 
@@ -326,19 +347,22 @@ std::pair<cv::Mat, cv::Mat> texturedPair(cv::Size size, uint64_t seed) {
 TEST_P(SimdKernels, WholePairsEqualTheReference) {
     const auto [left, right] = texturedPair({123, 77}, 3);
     for (int paths : {4, 5, 8})
-        for (int stripes : {1, 3}) {
-            sgm::Settings s;
-            s.numDisparities = 48;
-            s.minDisparity = 2;
-            s.paths = paths;
-            s.stripes = stripes;
-            s.p2IntensityStep = paths == 8 ? 24 : 0;
-            sgm::Engine a(s, sgm::scalarKernels()), b(s, simd());
-            const cv::Mat fa = a.computeFixed(left, right).clone();
-            const cv::Mat fb = b.computeFixed(left, right);
-            EXPECT_EQ(cv::countNonZero(fa != fb), 0) << "paths " << paths << ", stripes " << stripes;
-            EXPECT_GT(cv::countNonZero(fa), left.total() / 2) << "paths " << paths;
-        }
+        for (int stripes : {1, 3})
+            for (bool symmetric : {false, true}) {
+                sgm::Settings s;
+                s.numDisparities = 48;
+                s.minDisparity = 2;
+                s.paths = paths;
+                s.stripes = stripes;
+                s.p2IntensityStep = paths == 8 ? 24 : 0;
+                s.censusSymmetric = symmetric;
+                sgm::Engine a(s, sgm::scalarKernels()), b(s, simd());
+                const cv::Mat fa = a.computeFixed(left, right).clone();
+                const cv::Mat fb = b.computeFixed(left, right);
+                EXPECT_EQ(cv::countNonZero(fa != fb), 0)
+                    << "paths " << paths << ", stripes " << stripes << (symmetric ? ", centre-symmetric" : "");
+                EXPECT_GT(cv::countNonZero(fa), left.total() / 2) << "paths " << paths;
+            }
 }
 
 INSTANTIATE_TEST_SUITE_P(Tables, SimdKernels, ::testing::ValuesIn(simdTables()),

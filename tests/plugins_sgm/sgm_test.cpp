@@ -74,17 +74,23 @@ TEST(SgmPlugin, RefusesSettingsOutOfRange) {
     expectRefused<Matcher>(record, "uniqueness_ratio", "100", "uniqueness_ratio", "expected a value <= 99");
     expectRefused<Matcher>(record, "median_px", "7", "median_px", "expected a value <= 5");
     expectRefused<Matcher>(record, "paths", "6", "paths", "expected one of 4|5|8");
+    expectRefused<Matcher>(record, "census", "sparse", "census", "expected one of full|centre_symmetric");
 }
 
 TEST(SgmPlugin, RefusesSettingsThatDoNotFitTogether) {
-    const std::string window = errorOf([] { makeMatcher("sgm", "{census_width_px: 11, census_height_px: 7}"); });
+    const std::string window = errorOf([] { makeMatcher("sgm", "{census: full, census_width_px: 11, census_height_px: 7}"); });
     EXPECT_NE(window.find("census window 11 x 7 = 76 bits: expected census_width_px x census_height_px - 1 <= 64"),
               std::string::npos) << window;
     const std::string order = errorOf([] { makeMatcher("sgm", "{p1: 50, p2: 40}"); });
     EXPECT_NE(order.find("p2 = 40: expected more than p1 = 50"), std::string::npos) << order;
-    const std::string range = errorOf([] { makeMatcher("sgm", "{p2: 200}"); });
+    const std::string range = errorOf([] { makeMatcher("sgm", "{census: full, p2: 200}"); });
     EXPECT_NE(range.find("p2 = 200: expected at most 193 = 255 - the census window's 62 bits"), std::string::npos) << range;
-    EXPECT_NO_THROW(makeMatcher("sgm", "{census_width_px: 5, census_height_px: 5, p2: 230}"));
+    EXPECT_NO_THROW(makeMatcher("sgm", "{census: full, census_width_px: 5, census_height_px: 5, p2: 230}"));
+    // The centre-symmetric census (the default) has half the bits: 31 for 9 x 7, 38 for 11 x 7.
+    const std::string symmetric = errorOf([] { makeMatcher("sgm", "{p2: 230}"); });
+    EXPECT_NE(symmetric.find("p2 = 230: expected at most 224 = 255 - the census window's 31 bits"), std::string::npos)
+        << symmetric;
+    EXPECT_NO_THROW(makeMatcher("sgm", "{census_width_px: 11, census_height_px: 7, p2: 200}"));
 }
 
 TEST(SgmPlugin, RefusesAPairWhoseVolumeWouldNotFit) {
