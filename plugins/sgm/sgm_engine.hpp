@@ -38,12 +38,12 @@ struct Settings {
     int numDisparities = 64;
     int censusWidth = 9;
     int censusHeight = 7;
-    bool censusSymmetric = true; // centre-symmetric census: half the bits (sgm_kernels.hpp)
+    bool censusSymmetric = false; // centre-symmetric census: half the bits (sgm_kernels.hpp)
     int paths = 4;              // 4 (horizontal + vertical), 5 (one pass), 8
-    int p1 = 6;
-    int p2 = 90;
+    int p1 = 10;
+    int p2 = 120;
     int p2IntensityStep = 30;   // 0: P2 constant; else P2 * s / (s + |intensity step|), >= p1
-    int uniquenessPercent = 6;
+    int uniquenessPercent = 8;
     int disp12MaxDiff = 1;      // -1: no left-right check
     bool subpixel = true;
     int medianPx = 5;           // 1: none

@@ -43,17 +43,17 @@ public:
                 .help("width of the census window; width x height - 1 <= 64 bits (9 x 7, 11 x 5, 7 x 9 ...)"),
             Param::integer("census_height_px", "7").min(3).max(9).odd().unit("px")
                 .help("height of the census window"),
-            Param::choice("census", "centre_symmetric", "full|centre_symmetric")
+            Param::choice("census", "full", "full|centre_symmetric")
                 .help("full: each neighbour against the centre (width x height - 1 bits); centre_symmetric: each pixel against its mirror image about the centre (half the bits, half the cost work)"),
             Param::choice("paths", "4", "4|5|8")
                 .help("aggregation paths: 8 (all), 4 (horizontal and vertical) or 5 (left, right and the three from above: one pass, no volume, least memory)"),
-            Param::integer("p1", "6").min(1).max(253)
-                .help("penalty for a disparity change of 1 px between neighbours, in census bits (10 suits census: full)"),
-            Param::integer("p2", "90").min(2).max(254)
-                .help("penalty for a larger change, > p1; census bits + p2 <= 255 (8-bit path costs); 120 suits census: full"),
+            Param::integer("p1", "10").min(1).max(253)
+                .help("penalty for a disparity change of 1 px between neighbours, in census bits"),
+            Param::integer("p2", "120").min(2).max(254)
+                .help("penalty for a larger change, > p1; census bits + p2 <= 255 (8-bit path costs)"),
             Param::integer("p2_intensity_step", "30").min(0).max(255)
                 .help("0 = p2 constant; else p2 * s / (s + |intensity step|), never below p1: cheaper jumps across edges"),
-            Param::integer("uniqueness_ratio", "6").min(0).max(99).unit("%")
+            Param::integer("uniqueness_ratio", "8").min(0).max(99).unit("%")
                 .help("the best sum must beat every other (away from +-1 px) by this margin; 0 = no check"),
             Param::integer("disp12_max_diff", "1").min(-1).max(1024).unit("px")
                 .help("largest difference allowed in the left-right consistency check; -1 = no check"),

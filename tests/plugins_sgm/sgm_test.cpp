@@ -86,11 +86,11 @@ TEST(SgmPlugin, RefusesSettingsThatDoNotFitTogether) {
     const std::string range = errorOf([] { makeMatcher("sgm", "{census: full, p2: 200}"); });
     EXPECT_NE(range.find("p2 = 200: expected at most 193 = 255 - the census window's 62 bits"), std::string::npos) << range;
     EXPECT_NO_THROW(makeMatcher("sgm", "{census: full, census_width_px: 5, census_height_px: 5, p2: 230}"));
-    // The centre-symmetric census (the default) has half the bits: 31 for 9 x 7, 38 for 11 x 7.
-    const std::string symmetric = errorOf([] { makeMatcher("sgm", "{p2: 230}"); });
+    // The centre-symmetric census has half the bits: 31 for 9 x 7, 38 for 11 x 7.
+    const std::string symmetric = errorOf([] { makeMatcher("sgm", "{census: centre_symmetric, p2: 230}"); });
     EXPECT_NE(symmetric.find("p2 = 230: expected at most 224 = 255 - the census window's 31 bits"), std::string::npos)
         << symmetric;
-    EXPECT_NO_THROW(makeMatcher("sgm", "{census_width_px: 11, census_height_px: 7, p2: 200}"));
+    EXPECT_NO_THROW(makeMatcher("sgm", "{census: centre_symmetric, census_width_px: 11, census_height_px: 7, p2: 200}"));
 }
 
 TEST(SgmPlugin, RefusesAPairWhoseVolumeWouldNotFit) {
