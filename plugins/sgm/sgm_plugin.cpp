@@ -48,9 +48,9 @@ public:
             Param::choice("paths", "4", "4|5|8")
                 .help("aggregation paths: 8 (all), 4 (horizontal and vertical) or 5 (left, right and the three from above: one pass, no volume, least memory)"),
             Param::integer("p1", "10").min(1).max(253)
-                .help("penalty for a disparity change of 1 px between neighbours, in census bits"),
+                .help("penalty for a disparity change of 1 px between neighbours, in census bits (6 suits census: centre_symmetric)"),
             Param::integer("p2", "120").min(2).max(254)
-                .help("penalty for a larger change, > p1; census bits + p2 <= 255 (8-bit path costs)"),
+                .help("penalty for a larger change, > p1; census bits + p2 <= 255 (8-bit path costs); 90 suits census: centre_symmetric"),
             Param::integer("p2_intensity_step", "30").min(0).max(255)
                 .help("0 = p2 constant; else p2 * s / (s + |intensity step|), never below p1: cheaper jumps across edges"),
             Param::integer("uniqueness_ratio", "8").min(0).max(99).unit("%")
