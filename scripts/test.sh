@@ -14,14 +14,10 @@ sanitize="${BINOCLE_SANITIZE_STEP:-1}"
 if [ "$sanitize" != 0 ]; then
   # The sanitizer tree builds while CTest runs, at the lowest priority: the tests leave
   # much of the two cores idle (they wait on child processes, sockets and deadlines) and
-  # the build takes only that. Its own process group (set -m), so that a failed CTest
-  # stops all of it; not its own session (setsid), which would put it in an autogroup of
-  # its own, where the scheduler shares the cores between groups and ignores the nice.
+  # the build takes only that. Its own session, so that a failed CTest stops all of it.
   sanitize_log="$(mktemp)"
-  set -m
-  nice -n 19 bash scripts/sanitize.sh --build-only >"$sanitize_log" 2>&1 &
+  setsid nice -n 19 bash scripts/sanitize.sh --build-only >"$sanitize_log" 2>&1 &
   sanitize_pid=$!
-  set +m
   trap 'kill -- "-$sanitize_pid" 2>/dev/null || true; rm -f "$sanitize_log"' EXIT
 fi
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 600
