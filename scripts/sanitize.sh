@@ -8,8 +8,7 @@
 #      and the bad-input corpus) under ASan + UBSan, halting on the first finding;
 #   2. each fuzz harness for $BINOCLE_FUZZ_SECONDS seconds (default 10) from its seed
 #      corpus in tests/fuzz/corpus/.
-# A finding fails the step. BINOCLE_SKIP_FUZZ=1 skips 2. With --build-only it builds and
-# stops (scripts/test.sh builds this tree while CTest runs, then runs this again).
+# A finding fails the step. BINOCLE_SKIP_FUZZ=1 skips 2.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir="${BINOCLE_SANITIZE_BUILD_DIR:-build-sanitize}"
@@ -37,10 +36,6 @@ targets=()
 for line in "${lines[@]}"; do targets+=("${line%% *}"); done
 cmake --build "$dir" -j "$jobs" --target binocle "${targets[@]}" binocle_fuzzers
 built=$(date +%s)
-if [ "${1:-}" = --build-only ]; then
-  echo "sanitize: build $((built - start)) s"
-  exit 0
-fi
 # Leak detection is off: the plugins' libraries (OpenCV's thread pool, GLib, Aravis)
 # keep allocations for the life of the process by design.
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
