@@ -6,13 +6,12 @@
 #include "sgm_kernels.hpp"
 
 #include <binocle/plugin.hpp>
+#include <binocle/settings.hpp>
 
-#include <cmath>
 #include <memory>
 #include <new>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,12 +19,6 @@ namespace {
 
 using binocle::sdk::Error;
 using binocle::sdk::Param;
-
-std::string number(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 using binocle::sdk::sizeText;
 
@@ -70,8 +63,10 @@ public:
         };
     }
 
-    SgmMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host) {
-        checkAgainstTable(p);
+    SgmMatcher(const binocle::sdk::Params &params, binocle::sdk::Host &host) {
+        // The SDK's settings checker: defaults, ranges, odd sizes, multiples and choices
+        // read from the table above, in the words every plugin uses.
+        const binocle::sdk::CheckedParams p(params, parameters(), "sgm");
         sgm::Settings s;
         s.minDisparity = static_cast<int>(p.integer("min_disparity"));
         s.numDisparities = static_cast<int>(p.integer("num_disparities"));
@@ -88,16 +83,19 @@ public:
         s.medianPx = static_cast<int>(p.integer("median_px"));
         s.stripes = static_cast<int>(p.integer("stripes"));
         s.maxMemoryBytes = static_cast<double>(p.integer("max_memory_mb")) * 1048576.0;
+        // Rules across settings, in the same words.
         const int bits = sgm::censusBits(s.censusWidth, s.censusHeight, s.censusSymmetric);
         if (bits > 64)
-            refuse("census window " + std::to_string(s.censusWidth) + " x " + std::to_string(s.censusHeight) + " = " +
-                   std::to_string(bits) + " bits: expected census_width_px x census_height_px - 1 <= 64 (9 x 7, 11 x 5, 7 x 9)");
-        if (s.p2 <= s.p1)
-            refuse("p2 = " + std::to_string(s.p2) + ": expected more than p1 = " + std::to_string(s.p1));
+            p.refuse("census_width_px x census_height_px", std::to_string(s.censusWidth) + " x " + std::to_string(s.censusHeight),
+                     "a window of at most 64 census bits (width x height - 1: 9 x 7, 11 x 5, 7 x 9); this one has " +
+                         std::to_string(bits));
+        if (s.p2 <= s.p1) p.refuse("p2", std::to_string(s.p2), "more than p1 = " + std::to_string(s.p1));
         if (bits + s.p2 > 255)
-            refuse("p2 = " + std::to_string(s.p2) + ": expected at most " + std::to_string(255 - bits) +
-                   " = 255 - the census window's " + std::to_string(bits) + " bits (path costs are 8-bit)");
-        engine_ = std::make_unique<sgm::Engine>(s, kernelsOf(p.string("kernels")));
+            p.refuse("p2", std::to_string(s.p2),
+                     "at most " + std::to_string(255 - bits) + " = 255 - the census window's " + std::to_string(bits) +
+                         " bits (path costs are 8-bit)");
+        const sgm::Kernels &kernels = kernelsOf(p.string("kernels"));
+        engine_ = std::make_unique<sgm::Engine>(s, kernels);
         minDisparity_ = s.minDisparity;
         numDisparities_ = s.numDisparities;
         host.debug("census " + std::to_string(s.censusWidth) + "x" + std::to_string(s.censusHeight) + ", paths " +
@@ -125,26 +123,6 @@ public:
 private:
     // The host validates settings against the table before create; a host that does not
     // (or a caller of the C table) gets the same refusal here.
-    static void checkAgainstTable(const binocle::sdk::Params &p) {
-        for (const binocle_param_desc &d : parameters()) {
-            const std::string key = d.name;
-            if (d.type == BINOCLE_PARAM_INT) {
-                const int64_t v = p.integer(key);
-                const std::string text = std::to_string(v);
-                if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MIN) && v < d.min) refuse(key + " = " + text + ": expected a value >= " + number(d.min));
-                if ((d.flags & BINOCLE_PARAM_FLAG_HAS_MAX) && v > d.max) refuse(key + " = " + text + ": expected a value <= " + number(d.max));
-                if ((d.flags & BINOCLE_PARAM_FLAG_ODD) && v % 2 == 0) refuse(key + " = " + text + ": expected an odd number");
-                if (d.multiple_of > 0 && v % d.multiple_of != 0)
-                    refuse(key + " = " + text + ": expected a multiple of " + std::to_string(d.multiple_of));
-            } else if (d.type == BINOCLE_PARAM_ENUM) {
-                const std::string v = p.string(key);
-                if (v.empty() || v.find('|') != std::string::npos ||
-                    (std::string("|") + d.choices + "|").find("|" + v + "|") == std::string::npos)
-                    refuse(key + " = '" + v + "': expected one of " + d.choices);
-            }
-        }
-    }
-
     static const sgm::Kernels &kernelsOf(const std::string &name) {
         if (name == "scalar") return sgm::scalarKernels();
         if (name == "baseline") {

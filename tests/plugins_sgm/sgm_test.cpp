@@ -65,21 +65,23 @@ TEST(SgmPlugin, MarksPixelsWithoutCandidatesInvalid) {
     EXPECT_GT(cv::countNonZero(error < 0.5), 100 * 80 * 0.9);
 }
 
+// The SDK's settings checker (binocle/settings.hpp) refuses these in the plugin, in the
+// words the host's rig validation uses.
 TEST(SgmPlugin, RefusesSettingsOutOfRange) {
     const PluginRecord &record = matcherRecord("sgm");
-    expectRefused<Matcher>(record, "num_disparities", "272", "num_disparities", "expected a value <= 256");
-    expectRefused<Matcher>(record, "num_disparities", "40", "num_disparities", "expected a multiple of 16");
-    expectRefused<Matcher>(record, "census_width_px", "8", "census_width_px", "expected an odd number");
-    expectRefused<Matcher>(record, "p1", "0", "p1", "expected a value >= 1");
-    expectRefused<Matcher>(record, "uniqueness_ratio", "100", "uniqueness_ratio", "expected a value <= 99");
-    expectRefused<Matcher>(record, "median_px", "7", "median_px", "expected a value <= 5");
-    expectRefused<Matcher>(record, "paths", "6", "paths", "expected one of 4|5|8");
-    expectRefused<Matcher>(record, "census", "sparse", "census", "expected one of full|centre_symmetric");
+    expectRefused<Matcher>(record, "num_disparities", "272", "num_disparities", "expected an integer multiple of 16 >= 16 <= 256");
+    expectRefused<Matcher>(record, "num_disparities", "40", "num_disparities", "expected an integer multiple of 16 >= 16 <= 256");
+    expectRefused<Matcher>(record, "census_width_px", "8", "census_width_px", "expected an odd integer >= 3 <= 11");
+    expectRefused<Matcher>(record, "p1", "0", "p1", "expected an integer >= 1 <= 253");
+    expectRefused<Matcher>(record, "uniqueness_ratio", "100", "uniqueness_ratio", "expected an integer >= 0 <= 99");
+    expectRefused<Matcher>(record, "median_px", "7", "median_px", "expected an odd integer >= 1 <= 5");
+    expectRefused<Matcher>(record, "paths", "6", "paths", "expected one of 4, 5, 8");
+    expectRefused<Matcher>(record, "census", "sparse", "census", "expected full or centre_symmetric");
 }
 
 TEST(SgmPlugin, RefusesSettingsThatDoNotFitTogether) {
     const std::string window = errorOf([] { makeMatcher("sgm", "{census: full, census_width_px: 11, census_height_px: 7}"); });
-    EXPECT_NE(window.find("census window 11 x 7 = 76 bits: expected census_width_px x census_height_px - 1 <= 64"),
+    EXPECT_NE(window.find("census_width_px x census_height_px = 11 x 7: expected a window of at most 64 census bits"),
               std::string::npos) << window;
     const std::string order = errorOf([] { makeMatcher("sgm", "{p1: 50, p2: 40}"); });
     EXPECT_NE(order.find("p2 = 40: expected more than p1 = 50"), std::string::npos) << order;
