@@ -44,7 +44,11 @@ void putGroundPose(binocle_eval_input &in, const RigConfig &rig) {
 void Pipeline::acquire(RunState &s) {
     const RuntimeOptions &rt = rig_.runtime;
     const bool retry = rt.on_source_error == RuntimeOptions::OnSourceError::Retry;
-    std::optional<Clock::time_point> outage;
+    // When the source's outage began (retry mode); none: the source is delivering. A
+    // time point and a flag, not std::optional: GCC 12 warns (wrongly) that the optional's
+    // value may be read uninitialized.
+    Clock::time_point outageSince{};
+    bool inOutage = false;
     auto pause = [&](std::chrono::milliseconds d) {
         const auto until = Clock::now() + d;
         while (Clock::now() < until && !s.stopRequested() && !s.aborted)
@@ -84,21 +88,22 @@ void Pipeline::acquire(RunState &s) {
             } catch (const PluginError &e) {
                 if (s.stopRequested() && e.code() == BINOCLE_ERR_TIMEOUT) break;
                 if (!retry || (e.code() != BINOCLE_ERR_DEVICE && e.code() != BINOCLE_ERR_TIMEOUT)) throw;
-                if (!outage) {
-                    outage = Clock::now();
+                if (!inOutage) {
+                    inOutage = true;
+                    outageSince = Clock::now();
                     ++s.sourceErrors;
                     s.lastSourceError = e.what();
                     spdlog::warn("source error, retrying for up to {} s: {}", rt.retry_for_s, e.what());
                 }
-                if (secondsSince(*outage) > rt.retry_for_s)
+                if (secondsSince(outageSince) > rt.retry_for_s)
                     throw Error(std::string(e.what()) + " (still failing after retry_for_s: " + std::to_string(rt.retry_for_s) + " s)");
                 pause(std::chrono::milliseconds(100));
                 continue;
             }
-            if (outage) {
+            if (inOutage) {
                 ++s.recoveries;
-                spdlog::info("source recovered after {:.1f} s", secondsSince(*outage));
-                outage.reset();
+                spdlog::info("source recovered after {:.1f} s", secondsSince(outageSince));
+                inOutage = false;
             }
             if (!frame) {
                 s.endOfStream = true;

@@ -217,7 +217,10 @@ std::string paperChart(const OJson &results, const std::map<std::string, std::ma
         const auto t = paper.find(id);
         if (t == paper.end() || !t->second.count("eta_3d_percent")) continue;
         const OJson m = row.contains("eta_3d_percent") ? row["eta_3d_percent"] : OJson();
-        c.groups.push_back({"test " + id, {m.is_number() ? m.get<double>() : NAN, t->second.at("eta_3d_percent")}});
+        BarGroup g;
+        g.label = "test " + id;
+        g.values = {m.is_number() ? m.get<double>() : NAN, t->second.at("eta_3d_percent")};
+        c.groups.push_back(std::move(g));
     }
     if (c.groups.empty()) return "";
     return "<figure class=\"chart\" id=\"chart-paper\">" + toSvg(c, 960, 420) + "<figcaption>" + escape(c.title) +
