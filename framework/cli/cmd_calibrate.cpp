@@ -259,7 +259,7 @@ int calibrate(const CalibrateArgs &args, const CLI::App &app) {
     return 0;
 }
 
-Register reg{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm>_f<mm>.yml per configuration",
+Register calibrateCommand{{"calibrate", "stereo calibration from chessboard pairs: calib_B<mm>_f<mm>.yml per configuration",
               "Calibrates one configuration of the head (baseline, lenses) from chessboard pairs:\n"
               "finds the board with sub-pixel corners in each pair, rejects poor pairs and says why\n"
               "(board not found, too small, blurred, corner order flipped between left and right),\n"

@@ -77,7 +77,7 @@ std::string bashScript(const CLI::App &root) {
     return s.str();
 }
 
-Register reg{{"completion", "print a shell completion script (bash) made from these definitions",
+Register completionCommand{{"completion", "print a shell completion script (bash) made from these definitions",
               "Example: source <(binocle completion bash)\n"
               "Installed packages ship it as share/bash-completion/completions/binocle.",
               define<std::string>(

@@ -275,7 +275,7 @@ int design(const DesignArgs &args) {
     return 0;
 }
 
-Register reg{{"design", "rank baselines and lenses for a target range or band by FF (Eq. 7), or by simulated η3D",
+Register designCommand{{"design", "rank baselines and lenses for a target range or band by FF (Eq. 7), or by simulated η3D",
               "Ranks every combination of the available baselines and lenses for the target\n"
               "range(s): configurations that see the whole test panel and whose disparity search\n"
               "reaches the range first, then by the predictor whose Spearman rho with measured\n"

@@ -61,7 +61,7 @@ int listDevices(const std::string &plugin) {
     return failures == 0 ? 0 : 1;
 }
 
-Register reg{{"devices", "list the devices each source plugin can see (cameras, stereo heads)",
+Register devicesCommand{{"devices", "list the devices each source plugin can see (cameras, stereo heads)",
               "Asks every source plugin (or only NAME) which devices it can open and prints\n"
               "them as YAML, one key per plugin:\n"
               "  gige:\n"

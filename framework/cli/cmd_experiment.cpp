@@ -68,7 +68,7 @@ int experiment(const ExperimentArgs &args) {
     return result.failed ? 1 : 0;
 }
 
-Register reg{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of errors and efficiencies, charts",
+Register experimentCommand{{"experiment", "run an experiment (E1, E2 of METHOD.md): a table of errors and efficiencies, charts",
               "Runs each test of the experiment file: the base rig with the test's baseline,\n"
               "focal length, range, camera height and inclination. The whole file, and the rig\n"
               "of every test, is validated before anything runs. Writes into DIR (default\n"

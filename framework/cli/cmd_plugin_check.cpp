@@ -34,7 +34,7 @@ int checkPluginCommand(PluginCheckArgs &args) {
     return report.passed() ? kExitOk : kExitFailed;
 }
 
-Register reg{{"plugin-check", "check a plugin against the ABI's rules (conformance kit), JUnit report",
+Register pluginCheckCommand{{"plugin-check", "check a plugin against the ABI's rules (conformance kit), JUnit report",
               "Runs the conformance battery of the plugin's kind, each case in a child process\n"
               "(a crash or a hang is a failed case, with the signal or the timeout):\n"
               "  all kinds   load (in a child first; RTLD_NOW), table, settings, create/destroy\n"

@@ -61,7 +61,7 @@ int listPlugins(const PluginsArgs &args) {
     return 0;
 }
 
-Register reg{{"plugins", "list the plugins found, with versions, and those refused and why",
+Register pluginsCommand{{"plugins", "list the plugins found, with versions, and those refused and why",
               "Lists every plugin in the search path ($BINOCLE_PLUGIN_PATH, then the install\n"
               "prefix next to this executable) with its kind, version and ABI/API versions, and\n"
               "every file or folder that was refused with the reason. Each file is first opened\n"

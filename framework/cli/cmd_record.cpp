@@ -70,7 +70,7 @@ int record(const RecordArgs &args) {
     return 0;
 }
 
-Register reg{{"record", "record a rig's source (any plugin) to a folder that replay plays back",
+Register recordCommand{{"record", "record a rig's source (any plugin) to a folder that replay plays back",
               "Records the rig's source, frame by frame, into DIR in the `recording` layout of\n"
               "the replay plugin (plugins/replay/README.md):\n"
               "  left/NNNNNN.png, right/NNNNNN.png   lossless PNG, NNNNNN = the source's sequence\n"

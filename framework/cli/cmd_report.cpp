@@ -28,7 +28,7 @@ int report(const ReportArgs &args) {
     return 0;
 }
 
-Register reg{{"report", "an experiment's results as one self-contained HTML file (table, charts, images)",
+Register reportCommand{{"report", "an experiment's results as one self-contained HTML file (table, charts, images)",
               "Reads what `binocle experiment --out DIR` wrote (results.json, charts, test_<id>/)\n"
               "and writes DIR/report.html: the results table (sortable), the charts, η3D against\n"
               "the form factor, every test's disparity and top/front/side density views, the\n"

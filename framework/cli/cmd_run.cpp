@@ -58,7 +58,7 @@ int runRig(const RunArgs &args) {
     return interrupted ? 128 + StopSignalGuard::signalNumber() : 0;
 }
 
-Register reg{{"run", "run a rig: disparity, cloud in ground coordinates, evaluators",
+Register runCommand{{"run", "run a rig: disparity, cloud in ground coordinates, evaluators",
               "Runs the rig's pipeline: acquire -> rectify -> disparity -> cloud -> transforms\n"
               "-> evaluators. Per frame it writes into DIR:\n"
               "  disparity_NNNNNN.png        16-bit disparity, KITTI convention (d * 256, 0 = invalid)\n"

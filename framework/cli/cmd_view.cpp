@@ -59,7 +59,7 @@ int view(ViewArgs &args) {
     return 0;
 }
 
-Register reg{{"view", "a live web page of a rig: images, disparity, density views, cloud, figures, controls",
+Register viewCommand{{"view", "a live web page of a rig: images, disparity, density views, cloud, figures, controls",
               "Runs the rig's pipeline and serves a page on this machine that shows the rectified\n"
               "images, the colourised disparity (scale in px and m), the top/front/side density\n"
               "views with the objects and panel the evaluators found, the cloud in 3D, and every\n"

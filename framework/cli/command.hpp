@@ -57,7 +57,7 @@ std::function<Runner(CLI::App &app)> define(Options options, Run run) {
 }
 
 // One static object per command file:
-// `Register reg{{"name", "summary", "details", define<NameArgs>(options, run)}};`
+// `Register nameCommand{{"name", "summary", "details", define<NameArgs>(options, run)}};`
 struct Register {
     explicit Register(Command c);
 };
