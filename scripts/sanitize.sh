@@ -40,9 +40,8 @@ built=$(date +%s)
 # keep allocations for the life of the process by design.
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-# The labelled executables themselves, each running its tests (gtest_discover_tests
-# keeps only a test's first label, so `ctest -L sanitize` would find none of them),
-# $jobs at a time; each one's output goes to its log, printed when it fails.
+# The labelled executables themselves, each running its tests with its SANITIZE_FILTER
+# (which CTest's registration knows nothing of), $jobs at a time; each one's output goes to its log, printed when it fails.
 export BINOCLE_PLUGIN_PATH="$PWD/$dir/lib/binocle/plugins"
 mkdir -p "$dir/sanitize-logs"
 run_one() { # <target> <gtest filter> <shard index>
