@@ -121,8 +121,7 @@ public:
     std::pair<int32_t, int32_t> disparityRange() const override { return {minDisparity_, numDisparities_}; }
 
 private:
-    // The host validates settings against the table before create; a host that does not
-    // (or a caller of the C table) gets the same refusal here.
+    // The kernel table named by `kernels`, refused when this CPU or build lacks it.
     static const sgm::Kernels &kernelsOf(const std::string &name) {
         if (name == "scalar") return sgm::scalarKernels();
         if (name == "baseline") {
