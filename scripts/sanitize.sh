@@ -29,47 +29,19 @@ fi
 # The plugins at -O1 (still instrumented): the simulated rig renders a frame in about 7 s
 # at -O0 and 0.65 s at -O1, and the tests that run it held most of the step's test time.
 cmake -S . -B "$dir" -DBINOCLE_FUZZ_SECONDS="$seconds" -DBINOCLE_PLUGIN_OPTIMIZATION=-O1 >/dev/null
-# The executables of the labelled tests (tests/CMakeLists.txt collects them, one
-# "<target> <gtest filter>" per line).
-mapfile -t lines < <(grep -v '^$' "$dir/sanitize-targets.txt")
-targets=()
-for line in "${lines[@]}"; do targets+=("${line%% *}"); done
+# The executables of the labelled tests (tests/CMakeLists.txt collects them, one a line).
+mapfile -t targets < <(grep -v '^$' "$dir/sanitize-targets.txt")
 cmake --build "$dir" -j "$jobs" --target binocle "${targets[@]}" binocle_fuzzers
 built=$(date +%s)
 # Leak detection is off: the plugins' libraries (OpenCV's thread pool, GLib, Aravis)
 # keep allocations for the life of the process by design.
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=0:strict_string_checks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-# The labelled executables themselves, each running its tests with its SANITIZE_FILTER
-# (which CTest's registration knows nothing of), $jobs at a time; each one's output goes to its log, printed when it fails.
-export BINOCLE_PLUGIN_PATH="$PWD/$dir/lib/binocle/plugins"
-mkdir -p "$dir/sanitize-logs"
-run_one() { # <target> <gtest filter> <shard index>
-  local exe log t0 status=0
-  exe=$(find "$dir/tests" -type f -name "$1" -perm -u+x | head -n 1)
-  log="$PWD/$dir/sanitize-logs/$1.$3.log"
-  [ -n "$exe" ] || { echo "sanitize: no executable for $1" >&2; return 1; }
-  t0=$(date +%s)
-  (cd "$(dirname "$exe")" && GTEST_TOTAL_SHARDS="$jobs" GTEST_SHARD_INDEX="$3" timeout 900 "./$1" --gtest_brief=1 "--gtest_filter=$2") >"$log" 2>&1 || status=$?
-  if [ "$status" = 0 ]; then
-    echo "== $1 shard $(( $3 + 1 ))/$jobs (ASan + UBSan, filter $2): passed in $(( $(date +%s) - t0 )) s"
-  else
-    cat "$log"
-    echo "sanitize: $1 shard $(( $3 + 1 ))/$jobs FAILED (exit $status; log: $log)" >&2
-    return 1
-  fi
-}
-export -f run_one
-export dir jobs
-# Each executable in $jobs shards (GoogleTest's GTEST_TOTAL_SHARDS): a few executables
-# hold most of the time under ASan (cli_test, record_test, bad_input_test: a minute or
-# more each), and whole executables left one core idle at the end. The tests of one
-# executable already run side by side under ctest, so shards may too.
-failed=0
-for line in "${lines[@]}"; do
-  for ((shard = 0; shard < jobs; ++shard)); do echo "$shard $line"; done
-done | xargs -d '\n' -P "$jobs" -I{} bash -fc 'set -- $0; run_one "$2" "$3" "$1"' {} || failed=1
-[ "$failed" = 0 ] || exit 1
+# The labelled executables, as CTest registers them in this tree (tests/CMakeLists.txt:
+# two GoogleTest shards each, with its SANITIZE_FILTER), $jobs at a time; a failing
+# shard's output is printed. The shards matter here: a few executables hold most of the
+# time under ASan (cli_test, bad_input_test, record_test), and whole ones left a core idle.
+ctest --test-dir "$dir" -L sanitize --output-on-failure -j "$jobs" --timeout 600
 tested=$(date +%s)
 if [ "${BINOCLE_SKIP_FUZZ:-0}" != 1 ]; then
   ctest --test-dir "$dir" -L fuzz --output-on-failure -j "$jobs" --timeout 600

@@ -22,7 +22,6 @@ using binocle::sdk::Param;
 
 using binocle::sdk::sizeText;
 
-[[noreturn]] void refuse(const std::string &what) { throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "sgm: " + what); }
 
 class SgmMatcher : public binocle::sdk::Matcher {
 public:
@@ -94,7 +93,7 @@ public:
             p.refuse("p2", std::to_string(s.p2),
                      "at most " + std::to_string(255 - bits) + " = 255 - the census window's " + std::to_string(bits) +
                          " bits (path costs are 8-bit)");
-        const sgm::Kernels &kernels = kernelsOf(p.string("kernels"));
+        const sgm::Kernels &kernels = kernelsOf(p);
         engine_ = std::make_unique<sgm::Engine>(s, kernels);
         minDisparity_ = s.minDisparity;
         numDisparities_ = s.numDisparities;
@@ -122,20 +121,22 @@ public:
 
 private:
     // The kernel table named by `kernels`, refused when this CPU or build lacks it.
-    static const sgm::Kernels &kernelsOf(const std::string &name) {
+    static const sgm::Kernels &kernelsOf(const binocle::sdk::CheckedParams &p) {
+        const std::string &name = p.string("kernels");
         if (name == "scalar") return sgm::scalarKernels();
         if (name == "baseline") {
             if (const sgm::Kernels *k = sgm::baselineKernels()) return *k;
-            refuse("kernels = 'baseline': this build has no SIMD for this CPU's baseline; expected auto or scalar");
+            p.refuse("kernels", "'baseline'", "auto or scalar (this build has no SIMD for this CPU's baseline)");
         }
         if (name == "avx2") {
             if (const sgm::Kernels *k = sgm::avx2Kernels()) return *k;
-            refuse("kernels = 'avx2': this CPU or this build has no AVX2; expected auto, baseline or scalar");
+            p.refuse("kernels", "'avx2'", "auto, baseline or scalar (this CPU or this build has no AVX2)");
         }
         if (name == "avx512") {
             if (const sgm::Kernels *k = sgm::avx512Kernels()) return *k;
-            refuse("kernels = 'avx512': this CPU or this build lacks one of AVX-512 F, BW, VL, DQ, CD, VBMI, VPOPCNTDQ and BITALG; expected auto, avx2, "
-                   "baseline or scalar");
+            p.refuse("kernels", "'avx512'",
+                     "auto, avx2, baseline or scalar (this CPU or this build lacks one of AVX-512 F, BW, VL, DQ, CD, "
+                     "VBMI, VPOPCNTDQ and BITALG)");
         }
         return sgm::bestKernels();
     }
