@@ -46,7 +46,8 @@ double Engine::workingBytes(int width, int height) const {
     const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
     const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* scratch sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
-    return volume + images + std::max(1, settings_.stripes) * stripe;
+    const double median = kFinishBands * 2.0 * medianScratch(width);
+    return volume + images + std::max(1, settings_.stripes) * stripe + median;
 }
 
 void Engine::prepare(int width, int height) {
@@ -83,16 +84,12 @@ void Engine::prepare(int width, int height) {
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
         s.bestSum.assign(w, 0);
-        s.rightKey.assign(w, UINT32_MAX);
+        s.rightKey.assign(w + 1, UINT32_MAX); // and a spare column
     }
     fixed_.create(height, width, CV_16UC1);
-    // Bands of the median and conversion: their output rows (a band and the rows around it).
-    bandOut_.assign(static_cast<size_t>(std::clamp(height / 32, 1, kFinishBands)), cv::Mat());
-    for (size_t i = 0; i < bandOut_.size(); ++i) {
-        const int n = static_cast<int>(bandOut_.size()), y0 = height * static_cast<int>(i) / n;
-        const int y1 = height * (static_cast<int>(i) + 1) / n, k = settings_.medianPx / 2;
-        bandOut_[i].create(std::min(height, y1 + k) - std::max(0, y0 - k), width, CV_16UC1);
-    }
+    // Bands of the median and conversion, run in parallel: a scratch each.
+    bandScratch_.assign(static_cast<size_t>(std::clamp(height / 32, 1, kFinishBands)),
+                        AlignedVector<uint16_t>(medianScratch(width), 0));
     ++allocations_;
 }
 
@@ -144,18 +141,21 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
     const int16_t *best = s.best.data();
     const uint16_t *bestSum = s.bestSum.data();
     uint32_t *rightKey = s.rightKey.data();
-    const int minD = settings_.minDisparity;
-    for (int x = 0; x < width_; ++x) {
+    const int minD = settings_.minDisparity, width = width_, maxDiff = settings_.disp12MaxDiff;
+    // Without a branch a pixel: one without candidate (d < 0, the left margin only) goes
+    // to the spare column `width`, which nothing reads.
+    for (int x = 0; x < width; ++x) {
         const int d = best[x];
-        if (d < 0) continue; // no candidate: the left margin only
-        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint32_t>(d);
-        rightKey[x - minD - d] = std::min(rightKey[x - minD - d], key);
+        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
+        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
+        slot = std::min(slot, key);
     }
-    for (int x = 0; x < width_; ++x) {
+    for (int x = 0; x < width; ++x) {
         const int d = best[x];
-        if (d < 0) continue;
-        const int rightD = static_cast<int>(rightKey[x - minD - d] & 0xFFFF);
-        out[x] = std::abs(rightD - d) > settings_.disp12MaxDiff ? 0 : out[x];
+        const int rightD = static_cast<int>(rightKey[d < 0 ? width : x - minD - d] & 0xFFFF);
+        // Kept or cleared by a mask, not by a branch (mismatches come in runs of any length).
+        const bool kept = d < 0 || std::abs(rightD - d) <= maxDiff;
+        out[x] = static_cast<uint16_t>(out[x] & -static_cast<int>(kept));
     }
 }
 
@@ -259,25 +259,17 @@ void Engine::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispari
     // A small median removes isolated outliers; an invalid pixel (0) among valid ones
     // is outvoted, a valid one among invalid ones is dropped. Median and conversion run
     // in bands of rows in parallel (in one thread they were a tenth of the frame's time
-    // on 2 threads); each band's median reads the medianPx / 2 rows around it, so the
-    // result is that of the whole image.
-    const int k = settings_.medianPx / 2, bands = static_cast<int>(bandOut_.size());
-    const float scale = 1.0f / 16;
+    // on 2 threads); each row's median reads the rows around it, the image's first and
+    // last rows repeated beyond it, so the result is that of the whole image.
+    const int size = settings_.medianPx, k = size / 2, bands = static_cast<int>(bandScratch_.size());
     cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range &range) {
         for (int i = range.start; i < range.end; ++i) {
             const int y0 = height_ * i / bands, y1 = height_ * (i + 1) / bands;
-            const int from = std::max(0, y0 - k), to = std::min(height_, y1 + k);
-            const cv::Mat *result = &fixed_;
-            int first = 0; // the row of result that holds image row 0
-            if (k > 0) {
-                cv::medianBlur(fixed_.rowRange(from, to), bandOut_[static_cast<size_t>(i)], settings_.medianPx);
-                result = &bandOut_[static_cast<size_t>(i)];
-                first = -from;
-            }
             for (int y = y0; y < y1; ++y) {
-                const uint16_t *src = result->ptr<uint16_t>(y + first);
-                float *dst = disparity.ptr<float>(y);
-                for (int x = 0; x < width_; ++x) dst[x] = src[x] == 0 ? invalid : static_cast<float>(src[x]) * scale;
+                const uint16_t *rows[kMaxMedianPx];
+                for (int j = 0; j < size; ++j) rows[j] = fixed_.ptr<uint16_t>(std::clamp(y + j - k, 0, height_ - 1));
+                kernels_.medianRow(rows, width_, size, bandScratch_[static_cast<size_t>(i)].data(), invalid,
+                                   disparity.ptr<float>(y));
             }
         }
     });

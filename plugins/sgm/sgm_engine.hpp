@@ -110,7 +110,7 @@ private:
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2ByStep_[511]; // P2 by intensity step -255..255 (PathParams::p2ByStep)
     cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
-    std::vector<cv::Mat> bandOut_; // per band of the median: its filtered rows
+    std::vector<AlignedVector<uint16_t>> bandScratch_; // per band of the median: its kernel's scratch
     AlignedVector<uint64_t> censusLeft_, censusRight_;
     AlignedVector<uint16_t> volume_;  // 8 paths: the pass down's sums
     AlignedVector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)

@@ -127,9 +127,28 @@ using WtaRowFn = void (*)(const uint16_t *sum, int width, const WtaParams &wp, i
 // (as pathRow with paths.count == 1 and dx 0), whose costs are added to the sums of the
 // horizontal paths (sum, read only) together with the pass down's kept vertical path
 // (keptPath, as addPathRow), then the winner takes all over those sums (as wtaRow).
+// sum holds the sums of two 8-bit paths (at most 2 x 255), so that every sum of the four
+// is at most kMaxSum4: the SIMD tables find the winner by keys (sum << kWinnerKeyShift | d
+// mod 64) that fit 16 bits.
+constexpr int kMaxSum4 = 4 * 255;
+constexpr int kWinnerKeyShift = 6;
+static_assert(kMaxSum4 < (1 << (16 - kWinnerKeyShift)), "a key of a sum of 4 paths and d mod 64 fits 16 bits");
 using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
                             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
                             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16);
+
+// The median of the median_px x median_px window (size 1, 3 or 5) around each pixel of a
+// row of disparities in 1/16 px (rows[0 .. size - 1]: the rows y - size / 2 .. y + size /
+// 2, the caller repeating the image's first and last rows beyond it; the first and last
+// columns are repeated likewise: OpenCV's medianBlur), converted to pixels: median / 16,
+// or `invalid` where the median is 0. scratch: medianScratch(width) 16-bit words.
+using MedianRowFn = void (*)(const uint16_t *const *rows, int width, int size, uint16_t *scratch, float invalid,
+                             float *out);
+constexpr int kMaxMedianPx = 5;
+// Room for kMaxMedianPx rows of sorted columns, each with its border and a vector of slack.
+static inline size_t medianScratch(int width) {
+    return kMaxMedianPx * (static_cast<size_t>(width) + kMaxMedianPx + 64);
+}
 
 struct Kernels {
     const char *name;
@@ -144,6 +163,7 @@ struct Kernels {
     AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
     UpWtaRowFn upWtaRow;
+    MedianRowFn medianRow;
 };
 
 const Kernels &scalarKernels();
@@ -160,16 +180,21 @@ const Kernels &bestKernels();
 
 // The sub-pixel refinement shared by every table (scalar per pixel: no SIMD to compare).
 // Returns (minD + d) * 16 + the parabola's offset in 1/16 px, or 0 when that is <= 0.
-static inline uint16_t refinedDisparity16(const uint16_t *s, int d, const WtaParams &wp) {
+// The same from the sums at d - 1, d and d + 1 (left and right are read only for 0 < d <
+// numDisp - 1).
+static inline uint16_t refinedDisparity16(int left, int centre, int right, int d, const WtaParams &wp) {
     int value = (wp.minDisparity + d) * 16;
     if (wp.subpixel && d > 0 && d < wp.numDisp - 1) {
-        const int left = s[d - 1], right = s[d + 1], centre = s[d];
         const int denom = left + right - 2 * centre > 1 ? left + right - 2 * centre : 1;
         // Rounded to the nearest 1/16 px as OpenCV's SGBM does (truncating division of a
         // value offset by half the divisor).
         value += ((left - right) * 16 + denom) / (2 * denom);
     }
     return value > 0 ? static_cast<uint16_t>(value) : 0;
+}
+static inline uint16_t refinedDisparity16(const uint16_t *s, int d, const WtaParams &wp) {
+    const bool inner = d > 0 && d < wp.numDisp - 1;
+    return refinedDisparity16(inner ? s[d - 1] : 0, s[d], inner ? s[d + 1] : 0, d, wp);
 }
 
 } // namespace sgm

@@ -169,12 +169,25 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
     wtaRowScalar(sums.data(), width, wp, best, bestSum, disparity16);
 }
 
+void medianRowScalar(const uint16_t *const *rows, int width, int size, uint16_t *, float invalid, float *out) {
+    const int r = size / 2;
+    uint16_t window[kMaxMedianPx * kMaxMedianPx];
+    for (int x = 0; x < width; ++x) {
+        int n = 0;
+        for (int i = 0; i < size; ++i)
+            for (int j = -r; j <= r; ++j) window[n++] = rows[i][std::clamp(x + j, 0, width - 1)];
+        std::nth_element(window, window + n / 2, window + n);
+        const uint16_t median = window[n / 2];
+        out[x] = median == 0 ? invalid : static_cast<float>(median) * (1.0f / 16);
+    }
+}
+
 } // namespace
 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar, costRowScalar,
                            pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
-                           upWtaRowScalar};
+                           upWtaRowScalar, medianRowScalar};
     return k;
 }
 

@@ -11,10 +11,13 @@
 #endif
 
 #include "sgm_kernels.hpp"
+#include "sgm_median.hpp"
 
 #include <opencv2/core/hal/intrin.hpp>
 
+#include <algorithm>
 #include <cstdlib>
+#include <iterator>
 #include <utility>
 
 #if CV_SIMD
@@ -606,11 +609,13 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 
 // Winner takes all, and the fused pass up of 4 paths that ends in it.
 #include "sgm_kernels_simd_wta.inl"
+// The median filter on the disparity.
+#include "sgm_kernels_simd_median.inl"
 
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, costRow32, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow};
+    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, costRow32, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow, medianRow};
     return k;
 }
 

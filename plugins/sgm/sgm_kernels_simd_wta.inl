@@ -88,9 +88,57 @@ void wtaRow(const uint16_t *sum, int width, const WtaParams &wp, int16_t *best, 
     }
 }
 
+// ---- the winner of 4 paths, by keys --------------------------------------------------
+// A sum of 4 paths is at most kMaxSum4 (10 bits): key = sum << 6 | d mod 64 fits 16 bits,
+// and the least key of a group of 64 disparities is its least sum and the lowest d that
+// holds it, in one minimum. Lanes d >= numDisp hold 0xFFFF, above every key.
+constexpr int kKeyGroup = 1 << kWinnerKeyShift;
+// How far ahead the fused pass up asks for its inputs (measured: 3 pixels too few, 6 to
+// 12 alike at 640 x 480 x 128).
+constexpr int kPrefetchPixels = 8;
+constexpr int kMaxKeyGroups = kMaxPaddedDisp / kKeyGroup;
+
+// The uniqueness test by keys: a rival d (|d - b| > 1) fails it when s * (100 - u) < m *
+// 100, that is when s < T(m) = ceil(m * 100 / (100 - u)), that is when its key is below
+// T(m) << 6. keysBelow(u)[m]: that bound (T capped at kMaxSum4 + 1, which every key of a
+// real candidate is below and 0xFFFF is not). One table per thread, made again only when
+// u changes.
+const uint16_t *keysBelow(int uniquenessPercent) {
+    thread_local int made = -1;
+    thread_local uint16_t below[kMaxSum4 + 1];
+    if (made != uniquenessPercent) {
+        const int keep = 100 - uniquenessPercent;
+        for (int m = 0; m <= kMaxSum4; ++m)
+            below[m] = static_cast<uint16_t>(std::min((m * 100 + keep - 1) / keep, kMaxSum4 + 1) << kWinnerKeyShift);
+        made = uniquenessPercent;
+    }
+    return below;
+}
+
+#if CV_SIMD_WIDTH == 64
+// AVX-512: the lanes a winner b leaves to its rivals (|d - b| > 1) as mask registers, one
+// 32-bit word per vector of 16-bit lanes: allowedLanes()[b * kWords + i].
+constexpr int kLaneWords = kMaxPaddedDisp / kLanes16;
+struct AllowedLanes {
+    uint32_t bits[kMaxPaddedDisp * kLaneWords];
+    AllowedLanes() {
+        for (int b = 0; b < kMaxPaddedDisp; ++b)
+            for (int d = 0; d < kMaxPaddedDisp; ++d) {
+                uint32_t &word = bits[b * kLaneWords + d / kLanes16];
+                if (d % kLanes16 == 0) word = 0;
+                if (std::abs(d - b) > 1) word |= 1u << (d % kLanes16);
+            }
+    }
+};
+const uint32_t *allowedLanes() {
+    static const AllowedLanes lanes;
+    return lanes.bits;
+}
+#endif
+
 // The pass up of 4 paths, fused (sgm_kernels.hpp): per pixel the vertical path from
-// below, the sums of the four paths in a buffer that stays in L1 (nothing 16-bit is
-// stored to the row), their minimum on the way, then the winner takes all.
+// below, the sums of the four paths as keys in a buffer that stays in L1 (nothing 16-bit
+// is stored to the row), the least key of each group on the way, then the winner.
 // Chunks: vectors per pixel (paddedDisp / kLanes8) when known at compile time (the loop
 // over the disparities unrolls), 0 when not.
 template <int Chunks>
@@ -99,25 +147,33 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
     const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
     const int stride = pathStride(paddedDisp);
-    const int whole = wp.numDisp / kLanes16 * kLanes16;
-    const uint16_t *laneD = laneDisparities();
+    const int groups = (paddedDisp + kKeyGroup - 1) / kKeyGroup;
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     // Local copies: the stores through uint8_t pointers below may alias anything, so the
     // compiler would otherwise load every field again at each pixel.
     const uint8_t *const prevL = paths.prevL[0], *const prevMin = paths.prevMin[0], *const lut = pp.p2ByStep;
     uint8_t *const curL = paths.curL[0], *const curMin = paths.curMin[0];
     const WtaParams w = wp;
-    // The sums of a batch of pixels first, then their winners: a winner is a long chain
-    // of dependent steps (least sum, lowest d, least sum away from it, parabola), and the
-    // chains of neighbouring pixels, side by side in the instruction stream, overlap.
+    // The low bits of each lane's key: d mod 64, or 0xFFFF for d >= numDisp.
+    alignas(64) uint16_t laneKey[kMaxPaddedDisp];
+    for (int d = 0; d < paddedDisp; ++d) laneKey[d] = d < w.numDisp ? static_cast<uint16_t>(d % kKeyGroup) : 0xFFFF;
+    const uint16_t *const below = keysBelow(w.uniquenessPercent);
+#if CV_SIMD_WIDTH == 64
+    const uint32_t *const allowed = allowedLanes();
+#else
+    const uint16_t *const laneD = laneDisparities();
+#endif
+    // The keys of a batch of pixels first, then their winners: a winner is a chain of
+    // dependent steps (least key, uniqueness, parabola), and the chains of neighbouring
+    // pixels, side by side in the instruction stream, overlap.
     constexpr int kBatch = 8;
-    alignas(64) uint16_t local[kBatch][kMaxPaddedDisp];
-    int leastOf[kBatch];
+    alignas(64) uint16_t keys[kBatch][kMaxPaddedDisp];
+    int winner[kBatch], leastSum[kBatch];
     for (int x0 = 0; x0 < width; x0 += kBatch) {
         const int n = std::min(kBatch, width - x0);
         for (int j = 0; j < n; ++j) {
             const int x = x0 + j;
-            uint16_t *sums = local[j];
+            uint16_t *key = keys[j];
             const bool has = prevL != nullptr;
             const uint8_t *prev = has ? prevL + static_cast<size_t>(x) * stride + 1 : freshPath();
             const int minPrev = has ? prevMin[x] : 255;
@@ -125,11 +181,21 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
             const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
             v_uint8 least = vx_setall_u8(255);
-            v_uint16 leastSum = vx_setall_u16(0xFFFF);
+            v_uint16 groupLeast[kMaxKeyGroups];
+            for (v_uint16 &g : groupLeast) g = vx_setall_u16(0xFFFF);
             uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
             const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
             const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
             const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+            // The streams of a pixel kPrefetchPixels on asked for now: the kept path and the
+            // costs come from memory (the pass down wrote them long before), the sums from
+            // L2, and the hardware prefetcher, following a dozen streams, falls behind.
+            for (int d = 0; d < paddedDisp; d += 64) {
+                __builtin_prefetch(c0 + kPrefetchPixels * paddedDisp + d);
+                __builtin_prefetch(k0 + kPrefetchPixels * stride + d);
+                __builtin_prefetch(s0 + kPrefetchPixels * paddedDisp + d);
+                __builtin_prefetch(s0 + kPrefetchPixels * paddedDisp + d + 32);
+            }
 #pragma GCC unroll 8
             for (int d = 0; d < paddedDisp; d += kLanes8) {
                 const uint8_t *q = prev + d;
@@ -143,19 +209,60 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
                 // with 512-bit vectors GCC splits it through the stack).
                 const v_uint16 lo = vx_load(s0 + d) + l0 + vx_load_expand(k0 + d);
                 const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + vx_load_expand(k0 + d + kLanes16);
-                v_store(sums + d, lo);
-                v_store(sums + d + kLanes16, hi);
-                if (d < whole) leastSum = v_min(leastSum, lo);
-                if (d + kLanes16 < whole) leastSum = v_min(leastSum, hi);
+                const v_uint16 keyLo = v_shl<kWinnerKeyShift>(lo) | vx_load_aligned(laneKey + d);
+                const v_uint16 keyHi = v_shl<kWinnerKeyShift>(hi) | vx_load_aligned(laneKey + d + kLanes16);
+                v_store_aligned(key + d, keyLo);
+                v_store_aligned(key + d + kLanes16, keyHi);
+                v_uint16 &group = groupLeast[d / kKeyGroup];
+                group = v_min(group, v_min(keyLo, keyHi));
             }
             curMin[x] = leastByte(least);
-            int m = leastWord(leastSum);
-            for (int d = whole; d < w.numDisp; ++d) m = std::min<int>(m, sums[d]);
-            leastOf[j] = m;
-            for (int d = w.numDisp; d < paddedDisp; ++d) sums[d] = 0xFFFF; // for wtaPixel<Vectors>
+            // The least sum over the groups, the first group on a tie: the lowest d.
+            int leastKey = leastWord(groupLeast[0]), leastGroup = 0;
+            for (int g = 1; g < groups; ++g) {
+                const int k = leastWord(groupLeast[g]);
+                const bool less = k >> kWinnerKeyShift < leastKey >> kWinnerKeyShift;
+                leastKey = less ? k : leastKey;
+                leastGroup = less ? g : leastGroup;
+            }
+            leastSum[j] = leastKey >> kWinnerKeyShift;
+            winner[j] = leastGroup * kKeyGroup + (leastKey & (kKeyGroup - 1));
         }
-        for (int j = 0; j < n; ++j)
-            wtaPixel<Chunks * kLanes8 / kLanes16>(local[j], leastOf[j], x0 + j, w, laneD, best, bestSum, disparity16);
+        for (int j = 0; j < n; ++j) {
+            const int x = x0 + j, b = winner[j], m = leastSum[j];
+            bestSum[x] = static_cast<uint16_t>(m);
+            if (x - w.minDisparity - b < 0) {
+                best[x] = -1;
+                disparity16[x] = 0;
+                continue;
+            }
+            best[x] = static_cast<int16_t>(b);
+            const uint16_t *key = keys[j];
+            const v_uint16 bound = vx_setall_u16(below[m]);
+#if CV_SIMD_WIDTH == 64
+            // A rival below the bound, among the lanes b leaves to its rivals.
+            __mmask32 rivals = 0;
+            const uint32_t *lanes = allowed + b * kLaneWords;
+#pragma GCC unroll 16
+            for (int d = 0, i = 0; d < paddedDisp; d += kLanes16, ++i)
+                rivals |= _mm512_mask_cmplt_epu16_mask(lanes[i], vx_load_aligned(key + d).val, bound.val);
+            const bool unique = rivals == 0;
+#else
+            // d - (b - 1), wrapped, is at most 2 exactly for b - 1, b, b + 1: not rivals.
+            const v_uint16 lowest = vx_setall_u16(static_cast<uint16_t>(b - 1)), two = vx_setall_u16(2);
+            v_uint16 rivals = vx_setzero_u16();
+#pragma GCC unroll 16
+            for (int d = 0; d < paddedDisp; d += kLanes16) {
+                const v_uint16 offset = v_sub_wrap(vx_load(laneD + d), lowest);
+                rivals = rivals | ((vx_load_aligned(key + d) < bound) & ~(v_min(offset, two) == offset));
+            }
+            const bool unique = !v_check_any(rivals);
+#endif
+            const bool inner = b > 0 && b < w.numDisp - 1;
+            disparity16[x] = unique ? refinedDisparity16(inner ? key[b - 1] >> kWinnerKeyShift : 0, m,
+                                                         inner ? key[b + 1] >> kWinnerKeyShift : 0, b, w)
+                                    : 0;
+        }
     }
 }
 
@@ -163,8 +270,13 @@ void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &pa
               const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
               const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
     switch (paddedDisp / kLanes8) {
+    // Only the counts of vectors a padded count (at most kMaxPaddedDisp) can have.
 #define SGM_UP_WTA(n) \
-    case n: return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
+    case n: \
+        if constexpr (n * kLanes8 <= kMaxPaddedDisp) \
+            return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, \
+                              disparity16); \
+        break;
         SGM_UP_WTA(1) SGM_UP_WTA(2) SGM_UP_WTA(4) SGM_UP_WTA(8)
 #undef SGM_UP_WTA
     default: return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);

@@ -4,12 +4,15 @@
 // widths that are no whole number of vectors.
 #include "sgm_engine.hpp"
 #include "sgm_kernels.hpp"
+#include "sgm_median.hpp"
 
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <algorithm>
+#include <cstring>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -225,6 +228,36 @@ TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
 }
 
 // The fused pass up of 4 paths (vertical path, sums, winner) equals the kernels it fuses.
+// What the fused pass up of one table writes for a row.
+struct UpWtaResult {
+    std::vector<uint8_t> path, mins;
+    std::vector<int16_t> best;
+    std::vector<uint16_t> bestSum, disparity16;
+};
+UpWtaResult upWta(const Kernels &table, const uint8_t *cost, int width, int dp, const uint8_t *prevL,
+                  const uint8_t *prevMin, const uint8_t *grey, const uint8_t *greyPrev, const sgm::PathParams &pp,
+                  const uint8_t *kept, const uint16_t *sum, const sgm::WtaParams &wp) {
+    const size_t w = static_cast<size_t>(width);
+    UpWtaResult r{std::vector<uint8_t>(w * sgm::pathStride(dp), sgm::kCostInvalid), std::vector<uint8_t>(w),
+                  std::vector<int16_t>(w), std::vector<uint16_t>(w), std::vector<uint16_t>(w)};
+    sgm::RowPaths rp{};
+    rp.count = 1;
+    rp.prevL[0] = prevL; // NULL: the path starts at this row
+    rp.prevMin[0] = prevMin;
+    rp.curL[0] = r.path.data();
+    rp.curMin[0] = r.mins.data();
+    table.upWtaRow(cost, width, dp, rp, grey, greyPrev, pp, kept, sum, wp, r.best.data(), r.bestSum.data(),
+                   r.disparity16.data());
+    return r;
+}
+void expectSameUpWta(const UpWtaResult &a, const UpWtaResult &b, const std::string &what) {
+    ASSERT_EQ(a.path, b.path) << what;
+    ASSERT_EQ(a.mins, b.mins) << what;
+    ASSERT_EQ(a.best, b.best) << what;
+    ASSERT_EQ(a.bestSum, b.bestSum) << what;
+    ASSERT_EQ(a.disparity16, b.disparity16) << what;
+}
+
 TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
     for (int width : kWidths)
         for (int numDisp : {16, 48, 64, 96, 128, 256})
@@ -237,33 +270,67 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                         const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const int minD = uniqueness == 10 ? 5 : 0;
                         const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
-                        const size_t w = static_cast<size_t>(width);
-                        std::vector<uint8_t> la(w * sgm::pathStride(c.dp), sgm::kCostInvalid), lb = la;
-                        std::vector<uint8_t> ma(w), mb(w);
-                        sgm::RowPaths ra{}, rb{};
-                        ra.count = rb.count = 1;
-                        ra.prevL[0] = rb.prevL[0] = first ? nullptr : c.prevL.data();
-                        ra.prevMin[0] = rb.prevMin[0] = c.prevMin.data();
-                        ra.curL[0] = la.data();
-                        rb.curL[0] = lb.data();
-                        ra.curMin[0] = ma.data();
-                        rb.curMin[0] = mb.data();
-                        std::vector<int16_t> ba(w), bb(w);
-                        std::vector<uint16_t> sa(w), sb(w), da(w), db(w);
-                        const std::vector<uint16_t> sum = c.sum;
-                        ref().upWtaRow(c.cost.data(), width, c.dp, ra, c.grey.data(), c.greyPrev.data(), pp,
-                                       kept.prevL.data(), sum.data(), wp, ba.data(), sa.data(), da.data());
-                        simd().upWtaRow(c.cost.data(), width, c.dp, rb, c.grey.data(), c.greyPrev.data(), pp,
-                                        kept.prevL.data(), sum.data(), wp, bb.data(), sb.data(), db.data());
+                        // The sums of two 8-bit paths, as the kernel takes them (at most 2 x 255).
+                        std::vector<uint16_t> sum = c.sum;
+                        for (auto &v : sum) v = static_cast<uint16_t>(rng() % 511);
+                        const std::vector<uint16_t> given = sum;
+                        const uint8_t *prevL = first ? nullptr : c.prevL.data();
+                        const auto run = [&](const Kernels &table) {
+                            return upWta(table, c.cost.data(), width, c.dp, prevL, c.prevMin.data(), c.grey.data(),
+                                         c.greyPrev.data(), pp, kept.prevL.data(), sum.data(), wp);
+                        };
                         const std::string what = "width " + std::to_string(width) + ", num_disparities " +
                                                  std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
-                        ASSERT_EQ(la, lb) << what;
-                        ASSERT_EQ(ma, mb) << what;
-                        ASSERT_EQ(ba, bb) << what;
-                        ASSERT_EQ(sa, sb) << what;
-                        ASSERT_EQ(da, db) << what;
-                        ASSERT_EQ(sum, c.sum) << "the horizontal sums are read only, " << what;
+                        ASSERT_NO_FATAL_FAILURE(expectSameUpWta(run(ref()), run(simd()), what));
+                        ASSERT_EQ(sum, given) << "the horizontal sums are read only, " << what;
                     }
+}
+
+// The fused pass up's uniqueness test at its boundary, as WinnerTakesAllUniquenessBoundary
+// below for wtaRow: per pixel a least sum m at b and a rival at b + k (k = -3 .. 3) whose
+// sum is the largest that fails the test or the least that passes. The path from below
+// starts at this row (its costs are the row's costs), so each sum is laid out over the
+// horizontal sums (<= 510), the costs and the kept path (<= 255 each).
+TEST_P(SimdKernels, FusedPassUpUniquenessBoundary) {
+    for (int numDisp : {16, 64, 128, 256})
+        for (int uniqueness : {1, 8, 15, 50}) {
+            const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp, simd().dispAlign);
+            const size_t w = static_cast<size_t>(width), stride = sgm::pathStride(dp);
+            std::vector<uint8_t> cost(w * dp), kept(w * stride, sgm::kCostInvalid), grey(w, 100);
+            std::vector<uint16_t> sum(w * dp);
+            for (int x = 0; x < width; ++x) {
+                std::vector<int> target(static_cast<size_t>(dp));
+                for (auto &t : target) t = 700 + static_cast<int>(rng() % (sgm::kMaxSum4 - 699));
+                const int b = static_cast<int>(rng() % static_cast<unsigned>(numDisp));
+                const int m = 50 + static_cast<int>(rng() % 250);
+                const int rival = std::clamp(b + static_cast<int>(rng() % 7) - 3, 0, numDisp - 1);
+                const int passing = (m * 100 + (100 - uniqueness) - 1) / (100 - uniqueness);
+                target[static_cast<size_t>(b)] = m;
+                if (rival != b) target[static_cast<size_t>(rival)] = std::max(m, passing - static_cast<int>(rng() % 2));
+                for (int d = 0; d < dp; ++d) {
+                    const int t = target[static_cast<size_t>(d)], h = std::min(t, 510), c = std::min(t - h, 255);
+                    sum[x * dp + d] = static_cast<uint16_t>(h);
+                    cost[x * dp + d] = static_cast<uint8_t>(c);
+                    kept[x * stride + 1 + d] = static_cast<uint8_t>(t - h - c);
+                }
+            }
+            const uint8_t lut[511] = {};
+            const sgm::PathParams pp{10, lut + 255};
+            const sgm::WtaParams wp{0, numDisp, dp, uniqueness, true};
+            const std::vector<uint8_t> noMin(w, 255);
+            const auto run = [&](const Kernels &table) {
+                return upWta(table, cost.data(), width, dp, nullptr, noMin.data(), grey.data(), grey.data(), pp,
+                             kept.data(), sum.data(), wp);
+            };
+            const std::string what = "num_disparities " + std::to_string(numDisp) + ", uniqueness " +
+                                     std::to_string(uniqueness);
+            const UpWtaResult a = run(ref());
+            ASSERT_NO_FATAL_FAILURE(expectSameUpWta(a, run(simd()), what));
+            const std::vector<uint16_t> &da = a.disparity16;
+            const auto rejected = std::count(da.begin() + numDisp, da.end(), 0);
+            EXPECT_GT(rejected, 0) << what;
+            EXPECT_LT(rejected, width - numDisp) << what;
+        }
 }
 
 // The winner of every pixel of a row of sums, the reference's and this table's: equal.
@@ -365,9 +432,75 @@ TEST_P(SimdKernels, WholePairsEqualTheReference) {
             }
 }
 
+// The median filter of every width and size: the same floats as the reference (random
+// disparities, a third of them 0, so that invalid medians occur).
+TEST_P(SimdKernels, MedianEqualsTheReference) {
+    for (int width : {1, 2, 7, 15, 16, 17, 31, 33, 63, 65, 97, 130, 641})
+        for (int size : {1, 3, 5}) {
+            std::vector<std::vector<uint16_t>> rows(static_cast<size_t>(size), std::vector<uint16_t>(width));
+            const uint16_t *at[sgm::kMaxMedianPx];
+            for (int r = 0; r < size; ++r) {
+                for (auto &v : rows[static_cast<size_t>(r)]) v = rng() % 3 == 0 ? 0 : static_cast<uint16_t>(rng());
+                at[r] = rows[static_cast<size_t>(r)].data();
+            }
+            std::vector<uint16_t> scratch(sgm::medianScratch(width));
+            std::vector<float> a(static_cast<size_t>(width)), b(a.size());
+            ref().medianRow(at, width, size, scratch.data(), -1.0f, a.data());
+            simd().medianRow(at, width, size, scratch.data(), -1.0f, b.data());
+            ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)))
+                << "width " << width << ", median_px " << size;
+        }
+}
+
 INSTANTIATE_TEST_SUITE_P(Tables, SimdKernels, ::testing::ValuesIn(simdTables()),
                          [](const ::testing::TestParamInfo<std::string> &i) { return i.param; });
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SimdKernels);
+
+// The median networks of sgm_median.hpp (the columns sorted, then the network) leave the
+// median on the middle wire for every input of 0s and 1s, so for every input (the 0-1
+// principle): all 2^9 and 2^25 of them, 64 at a time (bit i of a word: input i).
+bool selectsTheMedian(int k, const sgm::MedianComparator *net, size_t comparators) {
+    const int n = k * k;
+    const uint64_t inputs = uint64_t{1} << n, words = std::max<uint64_t>(1, inputs / 64);
+    // Bits 0..5 of the input index vary inside a word: wire w < 6 has a fixed pattern.
+    const uint64_t lowWire[6] = {0xAAAAAAAAAAAAAAAAull, 0xCCCCCCCCCCCCCCCCull, 0xF0F0F0F0F0F0F0F0ull,
+                                 0xFF00FF00FF00FF00ull, 0xFFFF0000FFFF0000ull, 0xFFFFFFFF00000000ull};
+    // Lanes of a word (its 6 low bits) with at least c ones.
+    uint64_t lanesWith[8] = {};
+    for (int lane = 0; lane < 64; ++lane)
+        for (int c = 0; c <= __builtin_popcount(lane); ++c) lanesWith[c] |= uint64_t{1} << lane;
+    const uint64_t used = inputs >= 64 ? ~uint64_t{0} : (uint64_t{1} << inputs) - 1;
+    for (uint64_t word = 0; word < words; ++word) {
+        uint64_t v[25];
+        for (int w = 0; w < n; ++w) v[w] = w < 6 ? lowWire[w] : ((word >> (w - 6)) & 1 ? ~uint64_t{0} : 0);
+        const auto exchange = [&](int i, int j) {
+            const uint64_t a = v[i], b = v[j];
+            v[i] = a & b;
+            v[j] = a | b;
+        };
+        for (int c = 0; c < k; ++c) { // each column sorted, top to bottom
+            if (k == 3)
+                for (const auto &p : sgm::kSort3) exchange(p[0] * k + c, p[1] * k + c);
+            else
+                for (const auto &p : sgm::kSort5) exchange(p[0] * k + c, p[1] * k + c);
+        }
+        for (size_t c = 0; c < comparators; ++c) exchange(net[c].i, net[c].j);
+        // The median is 1 exactly when at least n / 2 + 1 inputs are 1: the word's index
+        // gives the inputs 6 and up, the lane the inputs 0 to 5.
+        const int need = n / 2 + 1 - __builtin_popcountll(word);
+        const uint64_t expected = need <= 0 ? ~uint64_t{0} : need > 6 ? 0 : lanesWith[need];
+        if (((v[n / 2] ^ expected) & used) != 0) return false;
+    }
+    return true;
+}
+
+TEST(MedianNetworks, SelectTheMedianOfEveryZeroOneInput) {
+    EXPECT_TRUE(selectsTheMedian(3, sgm::kMedianOf9, std::size(sgm::kMedianOf9)));
+    EXPECT_TRUE(selectsTheMedian(5, sgm::kMedianOf25, std::size(sgm::kMedianOf25)));
+    // Without its last comparator neither does: the check can fail.
+    EXPECT_FALSE(selectsTheMedian(3, sgm::kMedianOf9, std::size(sgm::kMedianOf9) - 1));
+    EXPECT_FALSE(selectsTheMedian(5, sgm::kMedianOf25, std::size(sgm::kMedianOf25) - 1));
+}
 
 // Buffers are made for the first pair of a size and reused for every later one.
 TEST(SgmEngine, AllocatesOncePerImageSize) {
@@ -382,9 +515,10 @@ TEST(SgmEngine, AllocatesOncePerImageSize) {
     EXPECT_EQ(e.allocations(), 2);
 }
 
-// The median and the conversion run in bands of rows in parallel: the result is that of
-// one median over the whole fixed-point map, for every median size and heights that
-// leave bands of unequal size (and fewer rows than a band needs).
+// The median and the conversion run in bands of rows in parallel: the result is OpenCV's
+// medianBlur over the whole fixed-point map, for every median size, the reference and
+// the fastest table, and heights that leave bands of unequal size (and fewer rows than a
+// band needs).
 TEST(SgmEngine, MedianInBandsEqualsTheWholeImage) {
     for (const cv::Size size : {cv::Size(123, 77), cv::Size(90, 300), cv::Size(64, 20)})
         for (int median : {1, 3, 5}) {
@@ -392,20 +526,22 @@ TEST(SgmEngine, MedianInBandsEqualsTheWholeImage) {
             sgm::Settings s;
             s.numDisparities = 32;
             s.medianPx = median;
-            sgm::Engine e(s, sgm::bestKernels());
-            cv::Mat d(left.size(), CV_32FC1);
-            e.compute(left, right, d, -1.0f);
-            const cv::Mat fixed = e.computeFixed(left, right).clone();
-            cv::Mat filtered = fixed;
-            if (median > 1) cv::medianBlur(fixed, filtered, median);
-            cv::Mat expected(left.size(), CV_32FC1);
-            for (int y = 0; y < expected.rows; ++y)
-                for (int x = 0; x < expected.cols; ++x) {
-                    const int v = filtered.at<uint16_t>(y, x);
-                    expected.at<float>(y, x) = v == 0 ? -1.0f : v / 16.0f;
-                }
-            EXPECT_EQ(cv::countNonZero(expected != d), 0) << size << ", median " << median;
-            EXPECT_GT(cv::countNonZero(expected > 0), static_cast<int>(left.total() / 3)) << size;
+            for (const sgm::Kernels *table : {&sgm::scalarKernels(), &sgm::bestKernels()}) {
+                sgm::Engine e(s, *table);
+                cv::Mat d(left.size(), CV_32FC1);
+                e.compute(left, right, d, -1.0f);
+                const cv::Mat fixed = e.computeFixed(left, right).clone();
+                cv::Mat filtered = fixed;
+                if (median > 1) cv::medianBlur(fixed, filtered, median);
+                cv::Mat expected(left.size(), CV_32FC1);
+                for (int y = 0; y < expected.rows; ++y)
+                    for (int x = 0; x < expected.cols; ++x) {
+                        const int v = filtered.at<uint16_t>(y, x);
+                        expected.at<float>(y, x) = v == 0 ? -1.0f : v / 16.0f;
+                    }
+                EXPECT_EQ(cv::countNonZero(expected != d), 0) << size << ", median " << median << ", " << table->name;
+                EXPECT_GT(cv::countNonZero(expected > 0), static_cast<int>(left.total() / 3)) << size;
+            }
         }
 }
 
