@@ -133,30 +133,8 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
 void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
     if (sum) kernels_.wtaRow(sum, width_, wtaParams(), s.best.data(), s.bestSum.data(), fixed_.ptr<uint16_t>(y));
     if (settings_.disp12MaxDiff < 0) return;
-    uint16_t *out = fixed_.ptr<uint16_t>(y);
-    // Per right column the least (sum, d) of the left pixels that chose it, as one key:
-    // the sum in the high half, d in the low, so that one minimum keeps the least sum and,
-    // among equal sums, the least d (the leftmost such pixel, the first one met).
-    std::fill(s.rightKey.begin(), s.rightKey.end(), UINT32_MAX);
-    const int16_t *best = s.best.data();
-    const uint16_t *bestSum = s.bestSum.data();
-    uint32_t *rightKey = s.rightKey.data();
-    const int minD = settings_.minDisparity, width = width_, maxDiff = settings_.disp12MaxDiff;
-    // Without a branch a pixel: one without candidate (d < 0, the left margin only) goes
-    // to the spare column `width`, which nothing reads.
-    for (int x = 0; x < width; ++x) {
-        const int d = best[x];
-        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
-        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
-        slot = std::min(slot, key);
-    }
-    for (int x = 0; x < width; ++x) {
-        const int d = best[x];
-        const int rightD = static_cast<int>(rightKey[d < 0 ? width : x - minD - d] & 0xFFFF);
-        // Kept or cleared by a mask, not by a branch (mismatches come in runs of any length).
-        const bool kept = d < 0 || std::abs(rightD - d) <= maxDiff;
-        out[x] = static_cast<uint16_t>(out[x] & -static_cast<int>(kept));
-    }
+    kernels_.leftRightRow(s.best.data(), s.bestSum.data(), width_, settings_.minDisparity, settings_.disp12MaxDiff,
+                          s.rightKey.data(), fixed_.ptr<uint16_t>(y));
 }
 
 // Rows y0 .. y1 - 1. The vertical and diagonal paths start kStripeOverlapRows above (and

@@ -137,6 +137,14 @@ using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, cons
                             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
                             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16);
 
+// The left-right check of a row, after its winners (best, bestSum as wtaRow leaves them):
+// the right image's match of column xr is the left pixel of least (sum, d) that chose it
+// (as OpenCV's SGBM derives it, from the same sums); disparity16[x] becomes 0 where best[x]
+// differs from its right match's d by more than maxDiff (occluded or mismatched). rightKey:
+// width + 1 words of scratch.
+using LeftRightRowFn = void (*)(const int16_t *best, const uint16_t *bestSum, int width, int minDisparity, int maxDiff,
+                                uint32_t *rightKey, uint16_t *disparity16);
+
 // The median of the median_px x median_px window (size 1, 3 or 5) around each pixel of a
 // row of disparities in 1/16 px (rows[0 .. size - 1]: the rows y - size / 2 .. y + size /
 // 2, the caller repeating the image's first and last rows beyond it; the first and last
@@ -163,6 +171,7 @@ struct Kernels {
     AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
     UpWtaRowFn upWtaRow;
+    LeftRightRowFn leftRightRow;
     MedianRowFn medianRow;
 };
 

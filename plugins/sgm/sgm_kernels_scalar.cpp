@@ -169,6 +169,28 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
     wtaRowScalar(sums.data(), width, wp, best, bestSum, disparity16);
 }
 
+void leftRightRowScalar(const int16_t *best, const uint16_t *bestSum, int width, int minD, int maxDiff,
+                        uint32_t *rightKey, uint16_t *disparity16) {
+    // Per right column the least (sum, d) of the left pixels that chose it, as one key:
+    // the sum in the high half, d in the low, so that one minimum keeps the least sum and,
+    // among equal sums, the least d (the leftmost such pixel, the first one met).
+    std::fill(rightKey, rightKey + width + 1, UINT32_MAX);
+    // A pixel without candidate (d < 0, the left margin only) goes to the spare column
+    // `width`, which nothing reads: no branch a pixel.
+    for (int x = 0; x < width; ++x) {
+        const int d = best[x];
+        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
+        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
+        slot = std::min(slot, key);
+    }
+    for (int x = 0; x < width; ++x) {
+        const int d = best[x];
+        const int rightD = static_cast<int>(rightKey[d < 0 ? width : x - minD - d] & 0xFFFF);
+        const bool kept = d < 0 || std::abs(rightD - d) <= maxDiff;
+        disparity16[x] = kept ? disparity16[x] : 0;
+    }
+}
+
 void medianRowScalar(const uint16_t *const *rows, int width, int size, uint16_t *, float invalid, float *out) {
     const int r = size / 2;
     uint16_t window[kMaxMedianPx * kMaxMedianPx];
@@ -187,7 +209,7 @@ void medianRowScalar(const uint16_t *const *rows, int width, int size, uint16_t 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar, costRowScalar,
                            pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
-                           upWtaRowScalar, medianRowScalar};
+                           upWtaRowScalar, leftRightRowScalar, medianRowScalar};
     return k;
 }
 

@@ -266,6 +266,42 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
     }
 }
 
+// ---- the left-right check ----------------------------------------------------------
+// The keys of the right columns as the reference makes them (a pixel's right column may
+// be another's: the scatter stays scalar), then the check of kLanes32 pixels at once, their
+// right columns' keys gathered.
+void leftRightRow(const int16_t *best, const uint16_t *bestSum, int width, int minD, int maxDiff, uint32_t *rightKey,
+                  uint16_t *disparity16) {
+    constexpr int kLanes32 = v_int32::nlanes;
+    std::fill(rightKey, rightKey + width + 1, UINT32_MAX);
+    for (int x = 0; x < width; ++x) {
+        const int d = best[x];
+        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
+        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
+        slot = std::min(slot, key);
+    }
+    alignas(64) int32_t lane[kLanes32];
+    for (int i = 0; i < kLanes32; ++i) lane[i] = i;
+    const v_int32 iota = vx_load_aligned(lane), spare = vx_setall_s32(width), zero = vx_setzero_s32();
+    const v_int32 low = vx_setall_s32(0xFFFF), most = vx_setall_s32(maxDiff);
+    const int *keys = reinterpret_cast<const int *>(rightKey);
+    int x = 0;
+    for (; x + kLanes32 <= width; x += kLanes32) {
+        const v_int32 d = vx_load_expand(best + x);
+        const v_int32 none = d < zero;
+        const v_int32 column = v_select(none, spare, vx_setall_s32(x - minD) + iota - d);
+        const v_int32 rightD = v_lut(keys, column) & low;
+        const v_int32 mismatch = v_reinterpret_as_s32(v_abs(rightD - d)) > most;
+        const v_uint32 kept = v_reinterpret_as_u32(~(mismatch & ~none));
+        v_pack_store(disparity16 + x, vx_load_expand(disparity16 + x) & kept);
+    }
+    for (; x < width; ++x) {
+        const int d = best[x];
+        const int rightD = static_cast<int>(rightKey[d < 0 ? width : x - minD - d] & 0xFFFF);
+        disparity16[x] = d < 0 || std::abs(rightD - d) <= maxDiff ? disparity16[x] : 0;
+    }
+}
+
 void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
               const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
               const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {

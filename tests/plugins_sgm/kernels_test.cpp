@@ -432,6 +432,37 @@ TEST_P(SimdKernels, WholePairsEqualTheReference) {
             }
 }
 
+// The left-right check of every width: the same disparities as the reference. Winners
+// near their neighbours' (runs of d, d + 1: many pixels share a right column), some with
+// equal sums, the left margin without candidate.
+TEST_P(SimdKernels, LeftRightCheckEqualsTheReference) {
+    for (int width : {1, 2, 7, 15, 16, 17, 31, 33, 63, 65, 97, 130, 641})
+        for (int minD : {0, 5})
+            for (int maxDiff : {0, 1, 3}) {
+                const size_t w = static_cast<size_t>(width);
+                std::vector<int16_t> best(w);
+                std::vector<uint16_t> bestSum(w), d16(w);
+                int d = 0;
+                for (int x = 0; x < width; ++x) {
+                    d = std::clamp(d + static_cast<int>(rng() % 5) - 2, 0, 40);
+                    best[x] = x - minD - d < 0 ? -1 : static_cast<int16_t>(d);
+                    bestSum[x] = static_cast<uint16_t>(rng() % 8);
+                    d16[x] = best[x] < 0 ? 0 : static_cast<uint16_t>(1 + rng() % 4000);
+                }
+                std::vector<uint32_t> keys(w + 1);
+                std::vector<uint16_t> a = d16, b = d16;
+                ref().leftRightRow(best.data(), bestSum.data(), width, minD, maxDiff, keys.data(), a.data());
+                simd().leftRightRow(best.data(), bestSum.data(), width, minD, maxDiff, keys.data(), b.data());
+                const std::string what = "width " + std::to_string(width) + ", min_disparity " + std::to_string(minD) +
+                                         ", disp12_max_diff " + std::to_string(maxDiff);
+                ASSERT_EQ(a, b) << what;
+                if (width > 100) { // both outcomes occur
+                    EXPECT_GT(std::count(a.begin(), a.end(), 0), std::count(d16.begin(), d16.end(), 0)) << what;
+                    EXPECT_GT(std::count_if(a.begin(), a.end(), [](uint16_t v) { return v > 0; }), 0) << what;
+                }
+            }
+}
+
 // The median filter of every width and size: the same floats as the reference (random
 // disparities, a third of them 0, so that invalid medians occur).
 TEST_P(SimdKernels, MedianEqualsTheReference) {
