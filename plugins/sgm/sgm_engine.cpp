@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// sgm: the matching of one pair: census of both images, then per stripe of rows the
-// costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over
+// sgm: the matching of one pair, per stripe of rows in parallel: the census of both
+// images, the costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over
 // volumes the pass down kept), winner takes all with the left-right check, then a median.
 #include "sgm_engine.hpp"
 
@@ -43,11 +43,13 @@ double Engine::workingBytes(int width, int height) const {
     const double rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
     // 8-bit costs, and the 16-bit sums (8 paths) or the 8-bit vertical path (4 paths).
     const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
-    const double images = 2 * (w + 2 * rx) * (h + 2 * ry) + 2 * w * h * 8 /* census */ + 2 * w * h * 2 /* fixed */;
+    // Per stripe its rows and those its paths warm up on: padded grey rows and census words
+    // of both images (at most the image's height more than the image, in all).
+    const double stripes = std::max(1, settings_.stripes), rows = h + std::min(h, stripes * 2 * (kStripeOverlapRows + ry));
+    const double images = 2 * (w + 2 * rx) * rows + 2 * w * rows * 8 /* census */ + 2 * w * h * 2 /* fixed */;
     const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* scratch sums */ + 8 * w +
-                          8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_);
-    const double median = kFinishBands * 2.0 * medianScratch(width);
-    return volume + images + std::max(1, settings_.stripes) * stripe + median;
+                          8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_) + 2.0 * medianScratch(width);
+    return volume + images + stripes * stripe;
 }
 
 void Engine::prepare(int width, int height) {
@@ -67,14 +69,22 @@ void Engine::prepare(int width, int height) {
     height_ = height;
     const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height), dp = paddedDisp_;
     const size_t ds = pathStride(paddedDisp_);
-    censusLeft_.assign(w * h, 0);
-    censusRight_.assign(w * h, 0);
     volume_.assign(twoPass_ && !keepDownPath_ ? w * h * dp : 0, 0);
     // The sentinels at d = -1 and d = Dp of every pixel are written here, once.
     downPath_.assign(keepDownPath_ ? w * h * ds : 0, kCostInvalid);
     costVolume_.assign(twoPass_ ? w * h * dp : 0, 0);
     stripes_.assign(static_cast<size_t>(std::clamp(settings_.stripes, 1, height)), Stripe{});
-    for (Stripe &s : stripes_) {
+    const int n = static_cast<int>(stripes_.size());
+    for (int i = 0; i < n; ++i) {
+        Stripe &s = stripes_[static_cast<size_t>(i)];
+        s.y0 = height * i / n;
+        s.y1 = height * (i + 1) / n;
+        s.first = std::max(0, s.y0 - kStripeOverlapRows);
+        s.last = std::min(height, s.y1 + kStripeOverlapRows);
+        const size_t rows = static_cast<size_t>(s.last - s.first);
+        s.censusLeft.assign(rows * w, 0);
+        s.censusRight.assign(rows * w, 0);
+        s.medianScratch.assign(medianScratch(width), 0);
         s.cost.assign(w * dp, kCostInvalid);
         // The sentinels at d = -1 and d = Dp are written here once and never again.
         s.pathRows.assign(6 * w * ds, kCostInvalid);
@@ -87,30 +97,29 @@ void Engine::prepare(int width, int height) {
         s.rightKey.assign(w + 1, UINT32_MAX); // and a spare column
     }
     fixed_.create(height, width, CV_16UC1);
-    // Bands of the median and conversion, run in parallel: a scratch each.
-    bandScratch_.assign(static_cast<size_t>(std::clamp(height / 32, 1, kFinishBands)),
-                        AlignedVector<uint16_t>(medianScratch(width), 0));
     ++allocations_;
 }
 
-// The census of every row of both images, rows in parallel (one parallel loop: one wait
-// for the slowest thread, not two). The images are first padded by replication so that
-// the window never leaves them.
-void Engine::census(const cv::Mat &left, const cv::Mat &right) {
+// The census of the rows a stripe matches, of both images. The grey rows they read are
+// first padded by replication (left and right: the window never leaves them; above and
+// below: the image's first and last rows stand in for those beyond it).
+void Engine::censusOf(Stripe &s) {
     const int rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
-    cv::copyMakeBorder(left, paddedLeft_, ry, ry, rx, rx, cv::BORDER_REPLICATE);
-    cv::copyMakeBorder(right, paddedRight_, ry, ry, rx, rx, cv::BORDER_REPLICATE);
-    cv::parallel_for_(cv::Range(0, 2 * height_), [&](const cv::Range &range) {
-        const uint8_t *rows[16];
-        for (int i = range.start; i < range.end; ++i) {
-            const bool isLeft = i < height_;
-            const int y = isLeft ? i : i - height_;
-            const cv::Mat &padded = isLeft ? paddedLeft_ : paddedRight_;
-            for (int j = 0; j < settings_.censusHeight; ++j) rows[j] = padded.ptr<uint8_t>(y + j) + rx;
+    const int from = std::max(0, s.first - ry), to = std::min(height_, s.last + ry);
+    cv::copyMakeBorder(greyLeft_.rowRange(from, to), s.paddedLeft, 0, 0, rx, rx, cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+    cv::copyMakeBorder(greyRight_.rowRange(from, to), s.paddedRight, 0, 0, rx, rx,
+                       cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+    const uint8_t *rows[16];
+    for (int image = 0; image < 2; ++image) {
+        const cv::Mat &padded = image == 0 ? s.paddedLeft : s.paddedRight;
+        uint64_t *out = (image == 0 ? s.censusLeft : s.censusRight).data();
+        for (int y = s.first; y < s.last; ++y) {
+            for (int j = 0; j < settings_.censusHeight; ++j)
+                rows[j] = padded.ptr<uint8_t>(std::clamp(y + j - ry, 0, height_ - 1) - from) + rx;
             kernels_.censusRow(rows, width_, settings_.censusWidth, settings_.censusHeight, settings_.censusSymmetric,
-                               (isLeft ? censusLeft_ : censusRight_).data() + static_cast<size_t>(y) * width_);
+                               out + static_cast<size_t>(y - s.first) * width_);
         }
-    });
+    }
 }
 
 const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
@@ -121,7 +130,8 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
     // Words of at most 32 bits (the default centre-symmetric 9 x 7: 31) on 32-bit lanes.
     const bool narrow = censusBits(settings_.censusWidth, settings_.censusHeight, settings_.censusSymmetric) <= 32;
     const CostRowFn kernel = narrow ? kernels_.costRow32 : kernels_.costRow;
-    kernel(censusLeft_.data() + at, censusRight_.data() + at, width_, settings_.minDisparity, settings_.numDisparities,
+    const size_t census = static_cast<size_t>(y - s.first) * width_;
+    kernel(s.censusLeft.data() + census, s.censusRight.data() + census, width_, settings_.minDisparity, settings_.numDisparities,
            paddedDisp_, s.costScratch.data(), out);
     return out;
 }
@@ -140,8 +150,8 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
 // Rows y0 .. y1 - 1. The vertical and diagonal paths start kStripeOverlapRows above (and
 // for the pass up, below) the stripe, so that they arrive warmed up; the sums of those
 // rows go to scratch.
-void Engine::matchStripe(int index, int y0, int y1) {
-    Stripe &s = stripes_[static_cast<size_t>(index)];
+void Engine::matchStripe(Stripe &s) {
+    const int y0 = s.y0, y1 = s.y1;
     const size_t w = static_cast<size_t>(width_), ds = pathStride(paddedDisp_);
     const PathParams pp{settings_.p1, p2ByStep_ + 255};
     uint8_t *rowsL = s.pathRows.data();
@@ -213,44 +223,58 @@ void Engine::matchStripe(int index, int y0, int y1) {
             if (y == yLast) break;
         }
     };
-    run(downDx_, std::max(0, y0 - kStripeOverlapRows), y1 - 1, 1, true);
-    if (twoPass_) run(upDx_, std::min(height_ - 1, y1 - 1 + kStripeOverlapRows), y0, -1, false);
+    run(downDx_, s.first, y1 - 1, 1, true);
+    if (twoPass_) run(upDx_, s.last - 1, y0, -1, false);
 }
 
-const cv::Mat &Engine::computeFixed(const cv::Mat &left, const cv::Mat &right) {
+void Engine::medianRow(Stripe &s, int y, cv::Mat &disparity, float invalid) {
+    const int size = settings_.medianPx, k = size / 2;
+    const uint16_t *rows[kMaxMedianPx];
+    for (int j = 0; j < size; ++j) rows[j] = fixed_.ptr<uint16_t>(std::clamp(y + j - k, 0, height_ - 1));
+    kernels_.medianRow(rows, width_, size, s.medianScratch.data(), invalid, disparity.ptr<float>(y));
+}
+
+// A small median removes isolated outliers; an invalid pixel (0) among valid ones is
+// outvoted, a valid one among invalid ones is dropped. A stripe filters the rows whose
+// window lies in its own rows (or beyond the image); the medianPx / 2 rows on either side
+// of a border between stripes wait for both (they are filtered once all stripes are
+// done), so the result is that of one median over the whole image.
+void Engine::runStripe(Stripe &s, cv::Mat *disparity, float invalid) {
+    censusOf(s);
+    matchStripe(s);
+    if (!disparity) return;
+    const int k = settings_.medianPx / 2;
+    const int from = s.y0 == 0 ? 0 : s.y0 + k, to = s.y1 == height_ ? height_ : s.y1 - k;
+    for (int y = from; y < to; ++y) medianRow(s, y, *disparity, invalid);
+}
+
+// One parallel loop a pair (one wait for the slowest thread): each stripe whole in a task.
+void Engine::run(const cv::Mat &left, const cv::Mat &right, cv::Mat *disparity, float invalid) {
     CV_Assert(left.type() == CV_8UC1 && right.type() == CV_8UC1 && left.size() == right.size());
     prepare(left.cols, left.rows);
     greyLeft_ = left;
     greyRight_ = right;
-    census(left, right);
     const int n = static_cast<int>(stripes_.size());
     cv::parallel_for_(cv::Range(0, n), [&](const cv::Range &range) {
-        for (int i = range.start; i < range.end; ++i)
-            matchStripe(i, height_ * i / n, height_ * (i + 1) / n);
+        for (int i = range.start; i < range.end; ++i) runStripe(stripes_[static_cast<size_t>(i)], disparity, invalid);
     });
+    if (!disparity) return;
+    const int k = settings_.medianPx / 2;
+    for (int i = 1; i < n; ++i) {
+        const int border = stripes_[static_cast<size_t>(i)].y0;
+        for (int y = std::max(0, border - k); y < std::min(height_, border + k); ++y)
+            medianRow(stripes_[0], y, *disparity, invalid);
+    }
+}
+
+const cv::Mat &Engine::computeFixed(const cv::Mat &left, const cv::Mat &right) {
+    run(left, right, nullptr, 0.0f);
     return fixed_;
 }
 
 void Engine::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity, float invalid) {
     CV_Assert(disparity.type() == CV_32FC1 && disparity.size() == left.size());
-    computeFixed(left, right);
-    // A small median removes isolated outliers; an invalid pixel (0) among valid ones
-    // is outvoted, a valid one among invalid ones is dropped. Median and conversion run
-    // in bands of rows in parallel (in one thread they were a tenth of the frame's time
-    // on 2 threads); each row's median reads the rows around it, the image's first and
-    // last rows repeated beyond it, so the result is that of the whole image.
-    const int size = settings_.medianPx, k = size / 2, bands = static_cast<int>(bandScratch_.size());
-    cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range &range) {
-        for (int i = range.start; i < range.end; ++i) {
-            const int y0 = height_ * i / bands, y1 = height_ * (i + 1) / bands;
-            for (int y = y0; y < y1; ++y) {
-                const uint16_t *rows[kMaxMedianPx];
-                for (int j = 0; j < size; ++j) rows[j] = fixed_.ptr<uint16_t>(std::clamp(y + j - k, 0, height_ - 1));
-                kernels_.medianRow(rows, width_, size, bandScratch_[static_cast<size_t>(i)].data(), invalid,
-                                   disparity.ptr<float>(y));
-            }
-        }
-    });
+    run(left, right, &disparity, invalid);
 }
 
 } // namespace sgm

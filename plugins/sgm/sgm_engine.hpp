@@ -54,8 +54,6 @@ struct Settings {
 // Rows a stripe runs its vertical paths above (and below) its own rows before they count:
 // stripes are matched independently, in parallel.
 constexpr int kStripeOverlapRows = 16;
-// At most this many bands of rows for the median and the conversion, run in parallel.
-constexpr int kFinishBands = 8;
 
 class Engine {
 public:
@@ -77,6 +75,11 @@ public:
 
 private:
     struct Stripe {
+        int y0 = 0, y1 = 0;       // its rows
+        int first = 0, last = 0;  // the rows it matches, warm-up included: its census rows
+        cv::Mat paddedLeft, paddedRight; // rows first - ry .. last + ry (within the image), padded by rx
+        AlignedVector<uint64_t> censusLeft, censusRight; // rows first .. last - 1
+        AlignedVector<uint16_t> medianScratch;
         AlignedVector<uint8_t> cost, pathRows, pathMins, horizontal;
         AlignedVector<uint16_t> scratchSum;
         AlignedVector<uint64_t> costScratch;
@@ -85,8 +88,16 @@ private:
         std::vector<uint32_t> rightKey; // the left-right check's (sum, d) per right column
     };
     void prepare(int width, int height);
-    void census(const cv::Mat &left, const cv::Mat &right);
-    void matchStripe(int stripe, int y0, int y1);
+    // One stripe, all of it in one task: the census of its rows (and of the rows its paths
+    // warm up on), its matching, and the median of the rows whose window lies in it.
+    // disparity NULL: no median.
+    void runStripe(Stripe &s, cv::Mat *disparity, float invalid);
+    void censusOf(Stripe &s);
+    void matchStripe(Stripe &s);
+    // The median of row y (its window clamped to the image) and its conversion to pixels.
+    void medianRow(Stripe &s, int y, cv::Mat &disparity, float invalid);
+    // The whole pair; disparity NULL: no median (computeFixed).
+    void run(const cv::Mat &left, const cv::Mat &right, cv::Mat *disparity, float invalid);
     // The costs of row y: computed into the stripe's row (or into the cost volume, for a
     // row of the stripe's own in the pass down), or read back from the volume.
     const uint8_t *costRow(Stripe &s, int y, bool own, bool down);
@@ -109,9 +120,7 @@ private:
     bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
     std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2ByStep_[511]; // P2 by intensity step -255..255 (PathParams::p2ByStep)
-    cv::Mat greyLeft_, greyRight_, paddedLeft_, paddedRight_, fixed_;
-    std::vector<AlignedVector<uint16_t>> bandScratch_; // per band of the median: its kernel's scratch
-    AlignedVector<uint64_t> censusLeft_, censusRight_;
+    cv::Mat greyLeft_, greyRight_, fixed_;
     AlignedVector<uint16_t> volume_;  // 8 paths: the pass down's sums
     AlignedVector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
     AlignedVector<uint8_t> costVolume_; // and its costs, which the pass up reads again

@@ -546,34 +546,38 @@ TEST(SgmEngine, AllocatesOncePerImageSize) {
     EXPECT_EQ(e.allocations(), 2);
 }
 
-// The median and the conversion run in bands of rows in parallel: the result is OpenCV's
-// medianBlur over the whole fixed-point map, for every median size, the reference and
-// the fastest table, and heights that leave bands of unequal size (and fewer rows than a
-// band needs).
-TEST(SgmEngine, MedianInBandsEqualsTheWholeImage) {
+// The median and the conversion run in the stripes, in parallel (the rows around a border
+// between stripes once both are done): the result is OpenCV's medianBlur over the whole
+// fixed-point map, for every median size, the reference and the fastest table, and
+// heights and stripe counts that leave stripes of unequal size (and stripes of fewer rows
+// than a window).
+TEST(SgmEngine, MedianInStripesEqualsTheWholeImage) {
     for (const cv::Size size : {cv::Size(123, 77), cv::Size(90, 300), cv::Size(64, 20)})
-        for (int median : {1, 3, 5}) {
-            const auto [left, right] = texturedPair(size, 5);
-            sgm::Settings s;
-            s.numDisparities = 32;
-            s.medianPx = median;
-            for (const sgm::Kernels *table : {&sgm::scalarKernels(), &sgm::bestKernels()}) {
-                sgm::Engine e(s, *table);
-                cv::Mat d(left.size(), CV_32FC1);
-                e.compute(left, right, d, -1.0f);
-                const cv::Mat fixed = e.computeFixed(left, right).clone();
-                cv::Mat filtered = fixed;
-                if (median > 1) cv::medianBlur(fixed, filtered, median);
-                cv::Mat expected(left.size(), CV_32FC1);
-                for (int y = 0; y < expected.rows; ++y)
-                    for (int x = 0; x < expected.cols; ++x) {
-                        const int v = filtered.at<uint16_t>(y, x);
-                        expected.at<float>(y, x) = v == 0 ? -1.0f : v / 16.0f;
-                    }
-                EXPECT_EQ(cv::countNonZero(expected != d), 0) << size << ", median " << median << ", " << table->name;
-                EXPECT_GT(cv::countNonZero(expected > 0), static_cast<int>(left.total() / 3)) << size;
+        for (int median : {1, 3, 5})
+            for (int stripes : {1, 2, 7}) {
+                const auto [left, right] = texturedPair(size, 5);
+                sgm::Settings s;
+                s.numDisparities = 32;
+                s.medianPx = median;
+                s.stripes = stripes;
+                for (const sgm::Kernels *table : {&sgm::scalarKernels(), &sgm::bestKernels()}) {
+                    sgm::Engine e(s, *table);
+                    cv::Mat d(left.size(), CV_32FC1);
+                    e.compute(left, right, d, -1.0f);
+                    const cv::Mat fixed = e.computeFixed(left, right).clone();
+                    cv::Mat filtered = fixed;
+                    if (median > 1) cv::medianBlur(fixed, filtered, median);
+                    cv::Mat expected(left.size(), CV_32FC1);
+                    for (int y = 0; y < expected.rows; ++y)
+                        for (int x = 0; x < expected.cols; ++x) {
+                            const int v = filtered.at<uint16_t>(y, x);
+                            expected.at<float>(y, x) = v == 0 ? -1.0f : v / 16.0f;
+                        }
+                    EXPECT_EQ(cv::countNonZero(expected != d), 0)
+                        << size << ", median " << median << ", stripes " << stripes << ", " << table->name;
+                    EXPECT_GT(cv::countNonZero(expected > 0), static_cast<int>(left.total() / 3)) << size;
+                }
             }
-        }
 }
 
 // The volume of 4 and 8 paths is bounded: refused, with the figures, before any buffer.
