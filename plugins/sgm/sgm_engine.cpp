@@ -47,7 +47,7 @@ double Engine::workingBytes(int width, int height) const {
     // of both images (at most the image's height more than the image, in all).
     const double stripes = std::max(1, settings_.stripes), rows = h + std::min(h, stripes * 2 * (kStripeOverlapRows + ry));
     const double images = 2 * (w + 2 * rx) * rows + 2 * w * rows * 8 /* census */ + 2 * w * h * 2 /* fixed */;
-    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* scratch sums */ + 8 * w +
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* horizontal paths (4 paths) or a row of sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_) + 2.0 * medianScratch(width);
     return volume + images + stripes * stripe;
 }
@@ -90,7 +90,9 @@ void Engine::prepare(int width, int height) {
         s.pathRows.assign(6 * w * ds, kCostInvalid);
         s.pathMins.assign(6 * w, 0);
         s.horizontal.assign(horizontalScratch(width, paddedDisp_), kCostInvalid);
-        s.scratchSum.assign(2 * w * dp, 0); // two rows: the horizontal paths run two at once
+        s.scratchSum.assign(keepDownPath_ ? 0 : w * dp, 0);
+        // 4 paths: both horizontal paths of two rows (they run two rows at once).
+        s.horizontalPaths.assign(keepDownPath_ ? 4 * w * dp : 0, 0);
         s.costScratch.assign(kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_), 0);
         s.best.assign(w, -1);
         s.bestSum.assign(w, 0);
@@ -168,25 +170,28 @@ void Engine::matchStripe(Stripe &s) {
             const uint8_t *cost = costRow(s, y, own, down);
             // Rows outside the stripe only carry their paths on: no sums.
             uint16_t *sum = nullptr;
+            // 4 paths, pass up: this row's horizontal paths, kept whole (8-bit) for the fused
+            // kernel, which adds them. Those of two rows at once (four serial chains side by
+            // side, whose latencies overlap): this one's, and the next one's for the next step.
+            const uint8_t *forward = nullptr, *backward = nullptr;
             if (own && keepDownPath_) {
-                if (!down) { // the horizontal paths first, then this pass's and the kept vertical
-                    // Those of two rows at once (four serial chains side by side, whose
-                    // latencies overlap): this one's, and the next one's for the next step.
-                    uint16_t *second = s.scratchSum.data() + w * paddedDisp_;
+                if (!down) {
+                    const size_t row = w * paddedDisp_;
+                    uint8_t *const paths[4] = {s.horizontalPaths.data(), s.horizontalPaths.data() + row,
+                                               s.horizontalPaths.data() + 2 * row, s.horizontalPaths.data() + 3 * row};
                     const int next = y + step;
-                    if (y == pairedRow) {
-                        sum = second;
-                    } else if (y != yLast && next >= y0 && next < y1) {
-                        sum = s.scratchSum.data();
-                        kernels_.horizontalRows(cost, costRow(s, next, true, false), width_, paddedDisp_,
-                                                greyLeft_.ptr<uint8_t>(y), greyLeft_.ptr<uint8_t>(next), pp,
-                                                s.horizontal.data(), sum, second);
-                        pairedRow = next;
-                    } else {
-                        sum = s.scratchSum.data();
-                        kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
-                                               s.horizontal.data(), sum, true);
+                    const bool second = y == pairedRow;
+                    if (!second) {
+                        const bool pair = y != yLast && next >= y0 && next < y1;
+                        const uint8_t *costs[2] = {cost, pair ? costRow(s, next, true, false) : nullptr};
+                        const uint8_t *greys[2] = {greyLeft_.ptr<uint8_t>(y), greyLeft_.ptr<uint8_t>(pair ? next : y)};
+                        uint8_t *const forwards[2] = {paths[0], paths[2]}, *const backwards[2] = {paths[1], paths[3]};
+                        kernels_.horizontalPaths(costs, pair ? 2 : 1, width_, paddedDisp_, greys, pp, s.horizontal.data(),
+                                                 forwards, backwards);
+                        pairedRow = pair ? next : -1;
                     }
+                    forward = paths[second ? 2 : 0];
+                    backward = paths[second ? 3 : 1];
                 }
             } else if (own) {
                 // The pass down stores the horizontal paths' sums; the rest add to them (the
@@ -212,7 +217,7 @@ void Engine::matchStripe(Stripe &s) {
             if (own && keepDownPath_ && !down) {
                 // The vertical path, the sums and the winner in one kernel; then the check.
                 kernels_.upWtaRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp,
-                                  downPathRow(y), sum, wtaParams(), s.best.data(), s.bestSum.data(),
+                                  downPathRow(y), forward, backward, wtaParams(), s.best.data(), s.bestSum.data(),
                                   fixed_.ptr<uint16_t>(y));
                 finishRow(s, nullptr, y);
             } else {

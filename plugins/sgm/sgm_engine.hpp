@@ -81,7 +81,8 @@ private:
         AlignedVector<uint64_t> censusLeft, censusRight; // rows first .. last - 1
         AlignedVector<uint16_t> medianScratch;
         AlignedVector<uint8_t> cost, pathRows, pathMins, horizontal;
-        AlignedVector<uint16_t> scratchSum;
+        AlignedVector<uint16_t> scratchSum;       // a row of sums (5 paths)
+        AlignedVector<uint8_t> horizontalPaths;   // 4 paths: both horizontal paths of two rows
         AlignedVector<uint64_t> costScratch;
         std::vector<int16_t> best;
         std::vector<uint16_t> bestSum;

@@ -97,11 +97,14 @@ using PathRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const
 using HorizontalRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey,
                                  const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum);
 
-// Both horizontal paths of two rows (costs cost0 and cost1, intensities grey0 and grey1),
-// stored to sum0 and sum1: horizontalRow with initSum for each, run side by side.
-using HorizontalRowsFn = void (*)(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp,
-                                  const uint8_t *grey0, const uint8_t *grey1, const PathParams &pp, uint8_t *scratch,
-                                  uint16_t *sum0, uint16_t *sum1);
+// Both horizontal paths of `rows` rows (1 or 2, side by side: four serial chains whose
+// latencies overlap), each stored whole as 8-bit path costs in the cost-row layout
+// (width x paddedDisp bytes): forward[r] left to right, backward[r] right to left. The
+// fused pass up of 4 paths adds them (upWtaRow). scratch: horizontalScratch(width,
+// paddedDisp) bytes.
+using HorizontalPathsFn = void (*)(const uint8_t *const *cost, int rows, int width, int paddedDisp,
+                                   const uint8_t *const *grey, const PathParams &pp, uint8_t *scratch,
+                                   uint8_t *const *forward, uint8_t *const *backward);
 
 // Adds one stored path row (the path-row layout above) to a row of sums: the pass up of
 // 4 paths adds the pass down's vertical path, kept as 8-bit costs.
@@ -124,18 +127,18 @@ using WtaRowFn = void (*)(const uint16_t *sum, int width, const WtaParams &wp, i
                           uint16_t *disparity16);
 
 // The pass up of 4 paths, the last kernel of a row, fused: the vertical path from below
-// (as pathRow with paths.count == 1 and dx 0), whose costs are added to the sums of the
-// horizontal paths (sum, read only) together with the pass down's kept vertical path
-// (keptPath, as addPathRow), then the winner takes all over those sums (as wtaRow).
-// sum holds the sums of two 8-bit paths (at most 2 x 255), so that every sum of the four
-// is at most kMaxSum4: the SIMD tables find the winner by keys (sum << kWinnerKeyShift | d
-// mod 64) that fit 16 bits.
+// (as pathRow with paths.count == 1 and dx 0), whose costs are added to the row's
+// horizontal paths (forward, backward: as horizontalPaths stores them, read only) and
+// the pass down's kept vertical path (keptPath, as addPathRow), then the winner takes all
+// over those sums (as wtaRow). A sum of four 8-bit paths is at most kMaxSum4: the SIMD
+// tables find the winner by keys (sum << kWinnerKeyShift | d mod 64) that fit 16 bits.
 constexpr int kMaxSum4 = 4 * 255;
 constexpr int kWinnerKeyShift = 6;
 static_assert(kMaxSum4 < (1 << (16 - kWinnerKeyShift)), "a key of a sum of 4 paths and d mod 64 fits 16 bits");
 using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-                            const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-                            const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16);
+                            const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath,
+                            const uint8_t *forward, const uint8_t *backward, const WtaParams &wp, int16_t *best,
+                            uint16_t *bestSum, uint16_t *disparity16);
 
 // The left-right check of a row, after its winners (best, bestSum as wtaRow leaves them):
 // the right image's match of column xr is the left pixel of least (sum, d) that chose it
@@ -167,7 +170,7 @@ struct Kernels {
     CostRowFn costRow32; // census words < 2^32 only
     PathRowFn pathRow;
     HorizontalRowFn horizontalRow;
-    HorizontalRowsFn horizontalRows;
+    HorizontalPathsFn horizontalPaths;
     AddPathRowFn addPathRow;
     WtaRowFn wtaRow;
     UpWtaRowFn upWtaRow;

@@ -99,8 +99,10 @@ void pathRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPath
         }
 }
 
+// One horizontal path of a row, added to sum (or stored, when initSum; sum NULL: none);
+// path: each pixel's path costs too, in the cost-row layout (NULL: not kept).
 void horizontalPath(const uint8_t *cost, int width, int paddedDisp, bool forward, const uint8_t *grey,
-                    const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum) {
+                    const PathParams &pp, uint8_t *scratch, uint16_t *sum, bool initSum, uint8_t *path = nullptr) {
     const int stride = pathStride(paddedDisp);
     uint8_t *bufs[2] = {scratch + 1, scratch + stride + 1};
     const uint8_t *prev = freshPath();
@@ -110,7 +112,8 @@ void horizontalPath(const uint8_t *cost, int width, int paddedDisp, bool forward
         const int p2 = previousX < 0 ? pp.p2ByStep[0] : pp.p2ByStep[grey[x] - grey[previousX]];
         uint8_t *out = bufs[i & 1];
         minPrev = pathStep(cost + static_cast<size_t>(x) * paddedDisp, prev, minPrev, pp.p1, p2, out,
-                           sum + static_cast<size_t>(x) * paddedDisp, paddedDisp, initSum);
+                           sum ? sum + static_cast<size_t>(x) * paddedDisp : nullptr, paddedDisp, initSum);
+        if (path) std::copy(out, out + paddedDisp, path + static_cast<size_t>(x) * paddedDisp);
         prev = out;
         previousX = x;
     }
@@ -122,10 +125,12 @@ void horizontalRowScalar(const uint8_t *cost, int width, int paddedDisp, const u
     horizontalPath(cost, width, paddedDisp, true, grey, pp, scratch, sum, false);
 }
 
-void horizontalRowsScalar(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
-                          const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
-    horizontalRowScalar(cost0, width, paddedDisp, grey0, pp, scratch, sum0, true);
-    horizontalRowScalar(cost1, width, paddedDisp, grey1, pp, scratch, sum1, true);
+void horizontalPathsScalar(const uint8_t *const *cost, int rows, int width, int paddedDisp, const uint8_t *const *grey,
+                           const PathParams &pp, uint8_t *scratch, uint8_t *const *forward, uint8_t *const *backward) {
+    for (int r = 0; r < rows; ++r) {
+        horizontalPath(cost[r], width, paddedDisp, true, grey[r], pp, scratch, nullptr, false, forward[r]);
+        horizontalPath(cost[r], width, paddedDisp, false, grey[r], pp, scratch, nullptr, false, backward[r]);
+    }
 }
 
 void addPathRowScalar(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
@@ -158,12 +163,15 @@ void wtaRowScalar(const uint16_t *sum, int width, const WtaParams &wp, int16_t *
     }
 }
 
-// The three kernels it fuses, one after the other, on a copy of the sums.
+// The kernels it fuses, one after the other: the horizontal paths' sums, the path from
+// below added, the kept path added, the winners.
 void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-                    const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-                    const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+                    const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint8_t *forward,
+                    const uint8_t *backward, const WtaParams &wp, int16_t *best, uint16_t *bestSum,
+                    uint16_t *disparity16) {
     thread_local std::vector<uint16_t> sums; // grows once: no allocation per frame after the first
-    sums.assign(sum, sum + static_cast<size_t>(width) * paddedDisp);
+    sums.resize(static_cast<size_t>(width) * paddedDisp);
+    for (size_t i = 0; i < sums.size(); ++i) sums[i] = static_cast<uint16_t>(forward[i] + backward[i]);
     pathRowScalar(cost, width, paddedDisp, paths, grey, greyPrev, pp, sums.data(), false);
     addPathRowScalar(keptPath, width, paddedDisp, sums.data());
     wtaRowScalar(sums.data(), width, wp, best, bestSum, disparity16);
@@ -208,7 +216,7 @@ void medianRowScalar(const uint16_t *const *rows, int width, int size, uint16_t 
 
 const Kernels &scalarKernels() {
     static const Kernels k{"scalar", kDispAlign, censusRowScalar, costScratchScalar, costRowScalar, costRowScalar,
-                           pathRowScalar, horizontalRowScalar, horizontalRowsScalar, addPathRowScalar, wtaRowScalar,
+                           pathRowScalar, horizontalRowScalar, horizontalPathsScalar, addPathRowScalar, wtaRowScalar,
                            upWtaRowScalar, leftRightRowScalar, medianRowScalar};
     return k;
 }

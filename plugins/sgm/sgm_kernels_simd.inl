@@ -468,8 +468,9 @@ struct HorizontalChain {
     v_uint8 *prev = bufA, *cur = bufB;
     int minPrev = 255, previousX = -1;
 
+    // path: where the pixel's path costs go (the cost-row layout), instead of into sum.
     void step(const uint8_t *cost, int chunks, int paddedDisp, int x, const uint8_t *grey, const PathParams &pp,
-              const v_uint8 &p1, uint16_t *sum, bool initSum) {
+              const v_uint8 &p1, uint16_t *sum, bool initSum, uint8_t *path) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
         if (previousX < 0)
             for (int c = 0; c < chunks; ++c) prev[c] = invalid;
@@ -478,7 +479,7 @@ struct HorizontalChain {
         const v_uint8 base = vx_setall_u8(static_cast<uint8_t>(minPrev));
         const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
-        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+        uint16_t *s0 = path ? nullptr : sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 least = invalid;
         for (int c = 0; c < chunks; ++c) {
             const v_uint8 below = v_extract<kLanes8 - 1>(c > 0 ? prev[c - 1] : invalid, prev[c]); // d - 1
@@ -487,6 +488,10 @@ struct HorizontalChain {
             const v_uint8 l = vx_load(c0 + c * kLanes8) + (t - base);
             cur[c] = l;
             least = v_min(least, l);
+            if (path) {
+                v_store(path + static_cast<size_t>(x) * paddedDisp + c * kLanes8, l);
+                continue;
+            }
             v_uint16 lo, hi;
             v_expand(l, lo, hi);
             uint16_t *s = s0 + c * kLanes8;
@@ -517,13 +522,14 @@ struct RegisterChain {
         base = vx_setall_u8(kCostInvalid);
     }
     // p2: P2 between x and the previous pixel (any value for the first: its previous costs
-    // and minimum are 255, so is the jump).
+    // and minimum are 255, so is the jump). Paths: the pixel's path costs stored to path
+    // (the cost-row layout), else added to sum (stored, when initSum).
+    template <bool Paths>
     inline __attribute__((always_inline)) void step(const uint8_t *cost, int paddedDisp, int x, int p2,
-                                                    const v_uint8 &p1, uint16_t *sum, bool initSum) {
+                                                    const v_uint8 &p1, uint16_t *sum, bool initSum, uint8_t *path) {
         const v_uint8 invalid = vx_setall_u8(kCostInvalid);
         const v_uint8 jump = base + vx_setall_u8(static_cast<uint8_t>(p2));
         const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
-        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
         v_uint8 cur[Chunks];
         v_uint8 least = invalid;
 #pragma GCC unroll 8
@@ -535,6 +541,15 @@ struct RegisterChain {
             least = v_min(least, cur[c]);
         }
         base = leastByteEverywhere(least);
+        if constexpr (Paths) {
+#pragma GCC unroll 8
+            for (int c = 0; c < Chunks; ++c) {
+                prev[c] = cur[c];
+                v_store(path + static_cast<size_t>(x) * paddedDisp + c * kLanes8, cur[c]);
+            }
+            return;
+        }
+        uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
 #pragma GCC unroll 8
         for (int c = 0; c < Chunks; ++c) {
             prev[c] = cur[c];
@@ -552,24 +567,39 @@ struct RegisterChain {
     }
 };
 
-// Rows rows (1 or 2), each with both chains, all side by side; stored (initSum) or added.
-// p2Rows: scratch of Rows * (width + 1) bytes for the P2 of each pixel and its left
-// neighbour, looked up once per row for both directions: p2Of[r][x] for the pair x - 1, x.
-template <int Chunks, int Rows>
+// Rows rows (1 or 2), each with both chains, all side by side. Paths: each chain's path
+// costs stored whole (forward[r], backward[r]); else both added to sum[r] (stored, when
+// initSum). p2Rows: scratch of Rows * (width + 1) bytes for the P2 of each pixel and its
+// left neighbour, looked up once per row for both directions: p2Of[r][x] for the pair
+// x - 1, x.
+struct HorizontalOut {
+    uint16_t *const *sum;
+    bool initSum;
+    uint8_t *const *forward, *const *backward; // Paths
+};
+
+template <int Chunks, int Rows, bool Paths>
 void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
-                  const PathParams &pp, uint8_t *p2Rows, uint16_t *const *sum, bool initSum) {
+                  const PathParams &pp, uint8_t *p2Rows, const HorizontalOut &to) {
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     const uint8_t *rowCost[Rows], *p2Of[Rows];
-    uint16_t *rowSum[Rows];
+    uint16_t *rowSum[Rows] = {};
+    uint8_t *rowForward[Rows] = {}, *rowBackward[Rows] = {};
     for (int r = 0; r < Rows; ++r) {
         rowCost[r] = cost[r];
-        rowSum[r] = sum[r];
+        if constexpr (Paths) {
+            rowForward[r] = to.forward[r];
+            rowBackward[r] = to.backward[r];
+        } else {
+            rowSum[r] = to.sum[r];
+        }
         uint8_t *p2 = p2Rows + r * (static_cast<size_t>(width) + 1);
         const uint8_t *g = grey[r];
         p2[0] = p2[width] = pp.p2ByStep[0]; // the first pixel of each direction: any value
         for (int x = 1; x < width; ++x) p2[x] = pp.p2ByStep[g[x] - g[x - 1]];
         p2Of[r] = p2;
     }
+    const bool initSum = to.initSum;
     RegisterChain<Chunks> forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
@@ -577,56 +607,57 @@ void horizontalOf(const uint8_t *const *cost, int width, int paddedDisp, const u
         // matter; the first path to reach a pixel stores instead of adding.
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            forward[r].step(rowCost[r], paddedDisp, i, p2Of[r][i], p1, rowSum[r], initSum && i <= xb);
+            forward[r].template step<Paths>(rowCost[r], paddedDisp, i, p2Of[r][i], p1, rowSum[r], initSum && i <= xb,
+                                            rowForward[r]);
 #pragma GCC unroll 2
         for (int r = 0; r < Rows; ++r)
-            backward[r].step(rowCost[r], paddedDisp, xb, p2Of[r][xb + 1], p1, rowSum[r], initSum && xb > i);
+            backward[r].template step<Paths>(rowCost[r], paddedDisp, xb, p2Of[r][xb + 1], p1, rowSum[r],
+                                             initSum && xb > i, rowBackward[r]);
     }
 }
 
 // The generic chain, for more than 8 vectors per pixel (SSE2 / NEON with 256 disparities).
 template <int Rows>
 void horizontalAny(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey,
-                   const PathParams &pp, uint16_t *const *sum, bool initSum) {
+                   const PathParams &pp, const HorizontalOut &to) {
     const int chunks = paddedDisp / kLanes8;
     const v_uint8 p1 = vx_setall_u8(static_cast<uint8_t>(pp.p1));
     HorizontalChain forward[Rows], backward[Rows];
     for (int i = 0; i < width; ++i) {
         const int xb = width - 1 - i;
         for (int r = 0; r < Rows; ++r)
-            forward[r].step(cost[r], chunks, paddedDisp, i, grey[r], pp, p1, sum[r], initSum && i <= xb);
+            forward[r].step(cost[r], chunks, paddedDisp, i, grey[r], pp, p1, to.sum ? to.sum[r] : nullptr,
+                            to.initSum && i <= xb, to.forward ? to.forward[r] : nullptr);
         for (int r = 0; r < Rows; ++r)
-            backward[r].step(cost[r], chunks, paddedDisp, xb, grey[r], pp, p1, sum[r], initSum && xb > i);
+            backward[r].step(cost[r], chunks, paddedDisp, xb, grey[r], pp, p1, to.sum ? to.sum[r] : nullptr,
+                             to.initSum && xb > i, to.backward ? to.backward[r] : nullptr);
     }
 }
 
-template <int Rows>
+template <int Rows, bool Paths>
 void horizontal(const uint8_t *const *cost, int width, int paddedDisp, const uint8_t *const *grey, const PathParams &pp,
-                uint8_t *scratch, uint16_t *const *sum, bool initSum) {
+                uint8_t *scratch, const HorizontalOut &to) {
     uint8_t *p2Rows = scratch + 2 * pathStride(paddedDisp);
     switch (paddedDisp / kLanes8) {
-    case 1: return horizontalOf<1, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 2: return horizontalOf<2, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 3: return horizontalOf<3, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 4: return horizontalOf<4, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 5: return horizontalOf<5, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 6: return horizontalOf<6, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 7: return horizontalOf<7, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    case 8: return horizontalOf<8, Rows>(cost, width, paddedDisp, grey, pp, p2Rows, sum, initSum);
-    default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, sum, initSum);
+#define SGM_HORIZONTAL(n) \
+    case n: return horizontalOf<n, Rows, Paths>(cost, width, paddedDisp, grey, pp, p2Rows, to);
+        SGM_HORIZONTAL(1) SGM_HORIZONTAL(2) SGM_HORIZONTAL(3) SGM_HORIZONTAL(4)
+        SGM_HORIZONTAL(5) SGM_HORIZONTAL(6) SGM_HORIZONTAL(7) SGM_HORIZONTAL(8)
+#undef SGM_HORIZONTAL
+    default: return horizontalAny<Rows>(cost, width, paddedDisp, grey, pp, to);
     }
 }
 
 void horizontalRow(const uint8_t *cost, int width, int paddedDisp, const uint8_t *grey, const PathParams &pp,
                    uint8_t *scratch, uint16_t *sum, bool initSum) {
-    horizontal<1>(&cost, width, paddedDisp, &grey, pp, scratch, &sum, initSum);
+    horizontal<1, false>(&cost, width, paddedDisp, &grey, pp, scratch, HorizontalOut{&sum, initSum, nullptr, nullptr});
 }
 
-void horizontalRows(const uint8_t *cost0, const uint8_t *cost1, int width, int paddedDisp, const uint8_t *grey0,
-                    const uint8_t *grey1, const PathParams &pp, uint8_t *scratch, uint16_t *sum0, uint16_t *sum1) {
-    const uint8_t *cost[2] = {cost0, cost1}, *grey[2] = {grey0, grey1};
-    uint16_t *sum[2] = {sum0, sum1};
-    horizontal<2>(cost, width, paddedDisp, grey, pp, scratch, sum, true);
+void horizontalPaths(const uint8_t *const *cost, int rows, int width, int paddedDisp, const uint8_t *const *grey,
+                     const PathParams &pp, uint8_t *scratch, uint8_t *const *forward, uint8_t *const *backward) {
+    const HorizontalOut to{nullptr, false, forward, backward};
+    if (rows == 2) horizontal<2, true>(cost, width, paddedDisp, grey, pp, scratch, to);
+    else horizontal<1, true>(cost, width, paddedDisp, grey, pp, scratch, to);
 }
 
 void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum) {
@@ -649,7 +680,7 @@ void addPathRow(const uint8_t *pathRow, int width, int paddedDisp, uint16_t *sum
 } // namespace
 
 const Kernels &table(const char *name) {
-    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, costRow32, pathRow, horizontalRow, horizontalRows, addPathRow, wtaRow, upWtaRow, leftRightRow, medianRow};
+    static const Kernels k{name, kTableDispAlign, censusRow, costScratch, costRow, costRow32, pathRow, horizontalRow, horizontalPaths, addPathRow, wtaRow, upWtaRow, leftRightRow, medianRow};
     return k;
 }
 

@@ -143,8 +143,8 @@ const uint32_t *allowedLanes() {
 // over the disparities unrolls), 0 when not.
 template <int Chunks>
 void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPaths &paths, const uint8_t *grey,
-             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-             const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+             const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint8_t *forward,
+             const uint8_t *backward, const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
     const int paddedDisp = Chunks > 0 ? Chunks * kLanes8 : runtimePaddedDisp;
     const int stride = pathStride(paddedDisp);
     const int groups = (paddedDisp + kKeyGroup - 1) / kKeyGroup;
@@ -186,15 +186,17 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
             uint8_t *out = curL + static_cast<size_t>(x) * stride + 1;
             const uint8_t *c0 = cost + static_cast<size_t>(x) * paddedDisp;
             const uint8_t *k0 = keptPath + static_cast<size_t>(x) * stride + 1;
-            const uint16_t *s0 = sum + static_cast<size_t>(x) * paddedDisp;
+            const uint8_t *f0 = forward + static_cast<size_t>(x) * paddedDisp;
+            const uint8_t *b0 = backward + static_cast<size_t>(x) * paddedDisp;
             // The streams of a pixel kPrefetchPixels on asked for now: the kept path and the
-            // costs come from memory (the pass down wrote them long before), the sums from
-            // L2, and the hardware prefetcher, following a dozen streams, falls behind.
+            // costs come from memory (the pass down wrote them long before), the horizontal
+            // paths from L2, and the hardware prefetcher, following a dozen streams, falls
+            // behind.
             for (int d = 0; d < paddedDisp; d += 64) {
                 __builtin_prefetch(c0 + kPrefetchPixels * paddedDisp + d);
                 __builtin_prefetch(k0 + kPrefetchPixels * stride + d);
-                __builtin_prefetch(s0 + kPrefetchPixels * paddedDisp + d);
-                __builtin_prefetch(s0 + kPrefetchPixels * paddedDisp + d + 32);
+                __builtin_prefetch(f0 + kPrefetchPixels * paddedDisp + d);
+                __builtin_prefetch(b0 + kPrefetchPixels * paddedDisp + d);
             }
 #pragma GCC unroll 8
             for (int d = 0; d < paddedDisp; d += kLanes8) {
@@ -205,10 +207,11 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
                 least = v_min(least, l);
                 v_uint16 l0, l1;
                 v_expand(l, l0, l1);
-                // The kept path widened as it is loaded (not loaded whole, then split:
-                // with 512-bit vectors GCC splits it through the stack).
-                const v_uint16 lo = vx_load(s0 + d) + l0 + vx_load_expand(k0 + d);
-                const v_uint16 hi = vx_load(s0 + d + kLanes16) + l1 + vx_load_expand(k0 + d + kLanes16);
+                // The stored paths widened as they are loaded (not loaded whole, then split:
+                // with 512-bit vectors GCC splits them through the stack).
+                const v_uint16 lo = vx_load_expand(f0 + d) + vx_load_expand(b0 + d) + l0 + vx_load_expand(k0 + d);
+                const v_uint16 hi = vx_load_expand(f0 + d + kLanes16) + vx_load_expand(b0 + d + kLanes16) + l1 +
+                                    vx_load_expand(k0 + d + kLanes16);
                 const v_uint16 keyLo = v_shl<kWinnerKeyShift>(lo) | vx_load_aligned(laneKey + d);
                 const v_uint16 keyHi = v_shl<kWinnerKeyShift>(hi) | vx_load_aligned(laneKey + d + kLanes16);
                 v_store_aligned(key + d, keyLo);
@@ -303,18 +306,20 @@ void leftRightRow(const int16_t *best, const uint16_t *bestSum, int width, int m
 }
 
 void upWtaRow(const uint8_t *cost, int width, int paddedDisp, const RowPaths &paths, const uint8_t *grey,
-              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint16_t *sum,
-              const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
+              const uint8_t *greyPrev, const PathParams &pp, const uint8_t *keptPath, const uint8_t *forward,
+              const uint8_t *backward, const WtaParams &wp, int16_t *best, uint16_t *bestSum, uint16_t *disparity16) {
     switch (paddedDisp / kLanes8) {
     // Only the counts of vectors a padded count (at most kMaxPaddedDisp) can have.
 #define SGM_UP_WTA(n) \
     case n: \
         if constexpr (n * kLanes8 <= kMaxPaddedDisp) \
-            return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, \
-                              disparity16); \
+            return upWtaOf<n>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, forward, backward, wp, best, \
+                              bestSum, disparity16); \
         break;
         SGM_UP_WTA(1) SGM_UP_WTA(2) SGM_UP_WTA(4) SGM_UP_WTA(8)
 #undef SGM_UP_WTA
-    default: return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, sum, wp, best, bestSum, disparity16);
+    default:
+        return upWtaOf<0>(cost, width, paddedDisp, paths, grey, greyPrev, pp, keptPath, forward, backward, wp, best,
+                          bestSum, disparity16);
     }
 }

@@ -206,25 +206,33 @@ TEST_P(SimdKernels, PathsEqualTheReference) {
 }
 
 // The horizontal paths of two rows at once equal those of each row alone (stored sums).
-TEST_P(SimdKernels, HorizontalPathsOfTwoRowsEqualTheReference) {
+// Both horizontal paths of one row and of two rows side by side, stored whole: the
+// reference's and the table's equal, and together they are horizontalRow's sums.
+TEST_P(SimdKernels, HorizontalPathsEqualTheReference) {
     for (int width : kWidths)
-        for (int numDisp : {16, 64, 96, 128, 256}) {
-            const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
-            const int align = simd().dispAlign;
-            const PathCase a = pathCase(rng, width, numDisp, p1, p2, align), b = pathCase(rng, width, numDisp, p1, p2, align);
-            const sgm::PathParams pp{p1, a.lut.data() + 255};
-            std::vector<uint8_t> scratch(sgm::horizontalScratch(width, a.dp), sgm::kCostInvalid);
-            std::vector<uint16_t> ra0 = a.sum, ra1 = b.sum, rb0 = a.sum, rb1 = b.sum, one = a.sum;
-            ref().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
-                                 scratch.data(), ra0.data(), ra1.data());
-            simd().horizontalRows(a.cost.data(), b.cost.data(), width, a.dp, a.grey.data(), b.grey.data(), pp,
-                                  scratch.data(), rb0.data(), rb1.data());
-            const std::string what = "width " + std::to_string(width) + ", num_disparities " + std::to_string(numDisp);
-            ASSERT_EQ(ra0, rb0) << what;
-            ASSERT_EQ(ra1, rb1) << what;
-            ref().horizontalRow(a.cost.data(), width, a.dp, a.grey.data(), pp, scratch.data(), one.data(), true);
-            ASSERT_EQ(one, ra0) << "two rows against one, " << what;
-        }
+        for (int numDisp : {16, 64, 96, 128, 256})
+            for (int rows : {1, 2}) {
+                const int p1 = 1 + static_cast<int>(rng() % 20), p2 = 60 + static_cast<int>(rng() % 130);
+                const int align = simd().dispAlign;
+                const PathCase a = pathCase(rng, width, numDisp, p1, p2, align), b = pathCase(rng, width, numDisp, p1, p2, align);
+                const sgm::PathParams pp{p1, a.lut.data() + 255};
+                std::vector<uint8_t> scratch(sgm::horizontalScratch(width, a.dp), sgm::kCostInvalid);
+                const uint8_t *costs[2] = {a.cost.data(), b.cost.data()}, *greys[2] = {a.grey.data(), b.grey.data()};
+                const auto run = [&](const Kernels &table) {
+                    std::vector<std::vector<uint8_t>> out(4, std::vector<uint8_t>(static_cast<size_t>(width) * a.dp, 7));
+                    uint8_t *const forward[2] = {out[0].data(), out[2].data()}, *const backward[2] = {out[1].data(), out[3].data()};
+                    table.horizontalPaths(costs, rows, width, a.dp, greys, pp, scratch.data(), forward, backward);
+                    return out;
+                };
+                const auto ra = run(ref()), rb = run(simd());
+                const std::string what = "width " + std::to_string(width) + ", num_disparities " +
+                                         std::to_string(numDisp) + ", rows " + std::to_string(rows);
+                ASSERT_EQ(ra, rb) << what;
+                std::vector<uint16_t> sum(static_cast<size_t>(width) * a.dp);
+                ref().horizontalRow(a.cost.data(), width, a.dp, a.grey.data(), pp, scratch.data(), sum.data(), true);
+                for (size_t i = 0; i < sum.size(); ++i)
+                    ASSERT_EQ(sum[i], ra[0][i] + ra[1][i]) << "the two paths against horizontalRow's sums, " << what;
+            }
 }
 
 // The fused pass up of 4 paths (vertical path, sums, winner) equals the kernels it fuses.
@@ -236,7 +244,7 @@ struct UpWtaResult {
 };
 UpWtaResult upWta(const Kernels &table, const uint8_t *cost, int width, int dp, const uint8_t *prevL,
                   const uint8_t *prevMin, const uint8_t *grey, const uint8_t *greyPrev, const sgm::PathParams &pp,
-                  const uint8_t *kept, const uint16_t *sum, const sgm::WtaParams &wp) {
+                  const uint8_t *kept, const uint8_t *forward, const uint8_t *backward, const sgm::WtaParams &wp) {
     const size_t w = static_cast<size_t>(width);
     UpWtaResult r{std::vector<uint8_t>(w * sgm::pathStride(dp), sgm::kCostInvalid), std::vector<uint8_t>(w),
                   std::vector<int16_t>(w), std::vector<uint16_t>(w), std::vector<uint16_t>(w)};
@@ -246,8 +254,8 @@ UpWtaResult upWta(const Kernels &table, const uint8_t *cost, int width, int dp, 
     rp.prevMin[0] = prevMin;
     rp.curL[0] = r.path.data();
     rp.curMin[0] = r.mins.data();
-    table.upWtaRow(cost, width, dp, rp, grey, greyPrev, pp, kept, sum, wp, r.best.data(), r.bestSum.data(),
-                   r.disparity16.data());
+    table.upWtaRow(cost, width, dp, rp, grey, greyPrev, pp, kept, forward, backward, wp, r.best.data(),
+                   r.bestSum.data(), r.disparity16.data());
     return r;
 }
 void expectSameUpWta(const UpWtaResult &a, const UpWtaResult &b, const std::string &what) {
@@ -270,19 +278,20 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
                         const sgm::PathParams pp{p1, c.lut.data() + 255};
                         const int minD = uniqueness == 10 ? 5 : 0;
                         const sgm::WtaParams wp{minD, numDisp, c.dp, uniqueness, subpixel};
-                        // The sums of two 8-bit paths, as the kernel takes them (at most 2 x 255).
-                        std::vector<uint16_t> sum = c.sum;
-                        for (auto &v : sum) v = static_cast<uint16_t>(rng() % 511);
-                        const std::vector<uint16_t> given = sum;
+                        // The horizontal paths, 8-bit, in the cost-row layout.
+                        std::vector<uint8_t> forward(c.cost.size()), backward(c.cost.size());
+                        for (auto &v : forward) v = byte();
+                        for (auto &v : backward) v = byte();
+                        const std::vector<uint8_t> given = forward;
                         const uint8_t *prevL = first ? nullptr : c.prevL.data();
                         const auto run = [&](const Kernels &table) {
                             return upWta(table, c.cost.data(), width, c.dp, prevL, c.prevMin.data(), c.grey.data(),
-                                         c.greyPrev.data(), pp, kept.prevL.data(), sum.data(), wp);
+                                         c.greyPrev.data(), pp, kept.prevL.data(), forward.data(), backward.data(), wp);
                         };
                         const std::string what = "width " + std::to_string(width) + ", num_disparities " +
                                                  std::to_string(numDisp) + ", uniqueness " + std::to_string(uniqueness);
                         ASSERT_NO_FATAL_FAILURE(expectSameUpWta(run(ref()), run(simd()), what));
-                        ASSERT_EQ(sum, given) << "the horizontal sums are read only, " << what;
+                        ASSERT_EQ(forward, given) << "the horizontal paths are read only, " << what;
                     }
 }
 
@@ -290,14 +299,14 @@ TEST_P(SimdKernels, FusedPassUpEqualsTheReference) {
 // below for wtaRow: per pixel a least sum m at b and a rival at b + k (k = -3 .. 3) whose
 // sum is the largest that fails the test or the least that passes. The path from below
 // starts at this row (its costs are the row's costs), so each sum is laid out over the
-// horizontal sums (<= 510), the costs and the kept path (<= 255 each).
+// two horizontal paths, the costs and the kept path (<= 255 each).
 TEST_P(SimdKernels, FusedPassUpUniquenessBoundary) {
     for (int numDisp : {16, 64, 128, 256})
         for (int uniqueness : {1, 8, 15, 50}) {
             const int width = numDisp + 61, dp = sgm::paddedDisparities(numDisp, simd().dispAlign);
             const size_t w = static_cast<size_t>(width), stride = sgm::pathStride(dp);
             std::vector<uint8_t> cost(w * dp), kept(w * stride, sgm::kCostInvalid), grey(w, 100);
-            std::vector<uint16_t> sum(w * dp);
+            std::vector<uint8_t> forward(w * dp), backward(w * dp);
             for (int x = 0; x < width; ++x) {
                 std::vector<int> target(static_cast<size_t>(dp));
                 for (auto &t : target) t = 700 + static_cast<int>(rng() % (sgm::kMaxSum4 - 699));
@@ -307,11 +316,12 @@ TEST_P(SimdKernels, FusedPassUpUniquenessBoundary) {
                 const int passing = (m * 100 + (100 - uniqueness) - 1) / (100 - uniqueness);
                 target[static_cast<size_t>(b)] = m;
                 if (rival != b) target[static_cast<size_t>(rival)] = std::max(m, passing - static_cast<int>(rng() % 2));
-                for (int d = 0; d < dp; ++d) {
-                    const int t = target[static_cast<size_t>(d)], h = std::min(t, 510), c = std::min(t - h, 255);
-                    sum[x * dp + d] = static_cast<uint16_t>(h);
-                    cost[x * dp + d] = static_cast<uint8_t>(c);
-                    kept[x * stride + 1 + d] = static_cast<uint8_t>(t - h - c);
+                for (int d = 0; d < dp; ++d) { // the target in quarters
+                    const int t = target[static_cast<size_t>(d)], q = (t + 3) / 4; // the last: t - 3q <= q
+                    forward[x * dp + d] = static_cast<uint8_t>(q);
+                    backward[x * dp + d] = static_cast<uint8_t>(q);
+                    cost[x * dp + d] = static_cast<uint8_t>(q);
+                    kept[x * stride + 1 + d] = static_cast<uint8_t>(t - 3 * q);
                 }
             }
             const uint8_t lut[511] = {};
@@ -320,7 +330,7 @@ TEST_P(SimdKernels, FusedPassUpUniquenessBoundary) {
             const std::vector<uint8_t> noMin(w, 255);
             const auto run = [&](const Kernels &table) {
                 return upWta(table, cost.data(), width, dp, nullptr, noMin.data(), grey.data(), grey.data(), pp,
-                             kept.data(), sum.data(), wp);
+                             kept.data(), forward.data(), backward.data(), wp);
             };
             const std::string what = "num_disparities " + std::to_string(numDisp) + ", uniqueness " +
                                      std::to_string(uniqueness);
