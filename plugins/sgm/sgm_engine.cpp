@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // sgm: the matching of one pair, per stripe of rows in parallel: the census of both
-// images, the costs, the path aggregation (one pass down, and for 4 and 8 paths one pass up over
-// volumes the pass down kept), winner takes all with the left-right check, then a median.
+// images, the costs, the path aggregation (one pass down, and for 4 and 8 paths one pass
+// up over volumes the pass down kept), winner takes all with the left-right check, then a
+// median.
 #include "sgm_engine.hpp"
 
 #include <algorithm>
@@ -45,10 +46,13 @@ double Engine::workingBytes(int width, int height) const {
     const double volume = !twoPass_ ? 0 : keepDownPath_ ? w * h * (dp + ds) : w * h * dp * 3;
     // Per stripe its rows and those its paths warm up on: padded grey rows and census words
     // of both images (at most the image's height more than the image, in all).
-    const double stripes = std::max(1, settings_.stripes), rows = h + std::min(h, stripes * 2 * (kStripeOverlapRows + ry));
+    const double stripes = std::max(1, settings_.stripes);
+    const double rows = h + std::min(h, stripes * 2 * (kStripeOverlapRows + ry));
     const double images = 2 * (w + 2 * rx) * rows + 2 * w * rows * 8 /* census */ + 2 * w * h * 2 /* fixed */;
-    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) + w * dp * 4 /* horizontal paths (4 paths) or a row of sums */ + 8 * w +
-                          8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_) + 2.0 * medianScratch(width);
+    const double stripe = w * dp /* cost */ + 6 * w * ds + 6 * w + horizontalScratch(width, paddedDisp_) +
+                          w * dp * 4 /* horizontal paths (4 paths) or a row of sums */ + 8 * w +
+                          8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_) +
+                          2.0 * medianScratch(width);
     return volume + images + stripes * stripe;
 }
 
@@ -108,7 +112,8 @@ void Engine::prepare(int width, int height) {
 void Engine::censusOf(Stripe &s) {
     const int rx = settings_.censusWidth / 2, ry = settings_.censusHeight / 2;
     const int from = std::max(0, s.first - ry), to = std::min(height_, s.last + ry);
-    cv::copyMakeBorder(greyLeft_.rowRange(from, to), s.paddedLeft, 0, 0, rx, rx, cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+    cv::copyMakeBorder(greyLeft_.rowRange(from, to), s.paddedLeft, 0, 0, rx, rx,
+                       cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
     cv::copyMakeBorder(greyRight_.rowRange(from, to), s.paddedRight, 0, 0, rx, rx,
                        cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
     const uint8_t *rows[16];
@@ -133,8 +138,8 @@ const uint8_t *Engine::costRow(Stripe &s, int y, bool own, bool down) {
     const bool narrow = censusBits(settings_.censusWidth, settings_.censusHeight, settings_.censusSymmetric) <= 32;
     const CostRowFn kernel = narrow ? kernels_.costRow32 : kernels_.costRow;
     const size_t census = static_cast<size_t>(y - s.first) * width_;
-    kernel(s.censusLeft.data() + census, s.censusRight.data() + census, width_, settings_.minDisparity, settings_.numDisparities,
-           paddedDisp_, s.costScratch.data(), out);
+    kernel(s.censusLeft.data() + census, s.censusRight.data() + census, width_, settings_.minDisparity,
+           settings_.numDisparities, paddedDisp_, s.costScratch.data(), out);
     return out;
 }
 
