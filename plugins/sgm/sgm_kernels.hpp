@@ -147,6 +147,22 @@ using UpWtaRowFn = void (*)(const uint8_t *cost, int width, int paddedDisp, cons
 // width + 1 words of scratch.
 using LeftRightRowFn = void (*)(const int16_t *best, const uint16_t *bestSum, int width, int minDisparity, int maxDiff,
                                 uint32_t *rightKey, uint16_t *disparity16);
+// The first half of every table's check (scalar: pixels share right columns): per right
+// column the least (sum, d) of the left pixels that chose it, as one key, the sum in the
+// high half and d in the low, so that one minimum keeps the least sum and, among equal
+// sums, the least d (the leftmost such pixel, the first one met). A pixel without
+// candidate (d < 0, the left margin only) goes to the spare column `width`, which nothing
+// reads: no branch a pixel.
+static inline void rightColumnKeys(const int16_t *best, const uint16_t *bestSum, int width, int minDisparity,
+                                   uint32_t *rightKey) {
+    for (int x = 0; x <= width; ++x) rightKey[x] = UINT32_MAX;
+    for (int x = 0; x < width; ++x) {
+        const int d = best[x];
+        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
+        uint32_t &slot = rightKey[d < 0 ? width : x - minDisparity - d];
+        slot = slot < key ? slot : key;
+    }
+}
 
 // The median of the median_px x median_px window (size 1, 3 or 5) around each pixel of a
 // row of disparities in 1/16 px (rows[0 .. size - 1]: the rows y - size / 2 .. y + size /

@@ -179,18 +179,7 @@ void upWtaRowScalar(const uint8_t *cost, int width, int paddedDisp, const RowPat
 
 void leftRightRowScalar(const int16_t *best, const uint16_t *bestSum, int width, int minD, int maxDiff,
                         uint32_t *rightKey, uint16_t *disparity16) {
-    // Per right column the least (sum, d) of the left pixels that chose it, as one key:
-    // the sum in the high half, d in the low, so that one minimum keeps the least sum and,
-    // among equal sums, the least d (the leftmost such pixel, the first one met).
-    std::fill(rightKey, rightKey + width + 1, UINT32_MAX);
-    // A pixel without candidate (d < 0, the left margin only) goes to the spare column
-    // `width`, which nothing reads: no branch a pixel.
-    for (int x = 0; x < width; ++x) {
-        const int d = best[x];
-        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
-        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
-        slot = std::min(slot, key);
-    }
+    rightColumnKeys(best, bestSum, width, minD, rightKey);
     for (int x = 0; x < width; ++x) {
         const int d = best[x];
         const int rightD = static_cast<int>(rightKey[d < 0 ? width : x - minD - d] & 0xFFFF);

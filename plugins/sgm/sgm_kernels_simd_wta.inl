@@ -270,19 +270,12 @@ void upWtaOf(const uint8_t *cost, int width, int runtimePaddedDisp, const RowPat
 }
 
 // ---- the left-right check ----------------------------------------------------------
-// The keys of the right columns as the reference makes them (a pixel's right column may
-// be another's: the scatter stays scalar), then the check of kLanes32 pixels at once, their
-// right columns' keys gathered.
+// The keys of the right columns as every table makes them (rightColumnKeys), then the
+// check of kLanes32 pixels at once, their right columns' keys gathered.
 void leftRightRow(const int16_t *best, const uint16_t *bestSum, int width, int minD, int maxDiff, uint32_t *rightKey,
                   uint16_t *disparity16) {
     constexpr int kLanes32 = v_int32::nlanes;
-    std::fill(rightKey, rightKey + width + 1, UINT32_MAX);
-    for (int x = 0; x < width; ++x) {
-        const int d = best[x];
-        const uint32_t key = static_cast<uint32_t>(bestSum[x]) << 16 | static_cast<uint16_t>(d);
-        uint32_t &slot = rightKey[d < 0 ? width : x - minD - d];
-        slot = std::min(slot, key);
-    }
+    rightColumnKeys(best, bestSum, width, minD, rightKey);
     alignas(64) int32_t lane[kLanes32];
     for (int i = 0; i < kLanes32; ++i) lane[i] = i;
     const v_int32 iota = vx_load_aligned(lane), spare = vx_setall_s32(width), zero = vx_setzero_s32();
