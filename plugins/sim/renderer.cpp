@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace binocle::sim {
 
@@ -147,22 +148,51 @@ inline Vec3 onTangentPlane(const Vec3 &o, const Vec3 &dir, const Vec3 &n, double
     return o + (s > 0 && s < 1e12 ? s : 1e12) * dir;
 }
 
+// Relative tolerance of the occlusion test: a surface met by the right imager's ray less
+// than this fraction of the distance before the point does not hide it (0.006 mm at 6 m:
+// far below any surface's thickness, far above rounding).
+constexpr double kOcclusionTolerance = 1e-6;
+
+// Whether scene point p (met by a ray of the rectified left imager) is seen by the right
+// one: it lands inside the rectified right image, and the ray from the right optical
+// centre towards it meets no surface before it.
+bool seenBy(const Camera &right, const Tracer &tracer, const Vec3 &p) {
+    double u = 0, v = 0;
+    if (!right.project(p, u, v)) return false;
+    if (u < -0.5 || u > right.width - 0.5 || v < -0.5 || v > right.height - 0.5) return false;
+    const Vec3 toPoint = p - right.center;
+    const double distance = toPoint.norm();
+    Tracer::Hit hit;
+    // No hit at all: p lies on a surface seen from behind (the ground from below).
+    return tracer.trace(right.center, toPoint / distance, hit) && hit.t >= distance * (1 - kOcclusionTolerance);
+}
+
+// What the truth of one pixel is made from besides its ray.
+struct TruthContext {
+    const StereoRig &rig;
+    const Tracer &tracer;
+    const Camera &right; // rectified right imager
+    Vec3 axis;           // rectified optical axis, scene frame
+};
+
 // One pixel's worth of ground truth from the ray through its centre.
 struct TruthRow {
     float *disparity, *depth;
-    uint8_t *valid;
+    uint8_t *valid, *nonocc;
     uint16_t *id;
-    void set(int u, const StereoRig &rig, const Tracer &tracer, bool hit, const Tracer::Hit &h, double cosAxis) {
-        const double z = hit ? h.t * cosAxis : 0.0;
+    void set(int u, const TruthContext &c, const Vec3 &origin, const Vec3 &d, bool hit, const Tracer::Hit &h) {
+        const double z = hit ? h.t * d.dot(c.axis) : 0.0;
         if (z > 0 && std::isfinite(z)) {
             depth[u] = static_cast<float>(z);
-            disparity[u] = static_cast<float>(rig.rectifiedDisparity(z));
+            disparity[u] = static_cast<float>(c.rig.rectifiedDisparity(z));
             valid[u] = 255;
-            id[u] = tracer.objectId(h);
+            id[u] = c.tracer.objectId(h);
+            nonocc[u] = seenBy(c.right, c.tracer, origin + h.t * d) ? 255 : 0;
         } else {
             depth[u] = 0;
             disparity[u] = -1.0f;
             valid[u] = 0;
+            nonocc[u] = 0;
             id[u] = Scene::kSkyId;
         }
     }
@@ -172,12 +202,13 @@ void allocateTruth(RenderedFrame &out, int width, int height) {
     out.gt_disparity.create(height, width, CV_32F);
     out.gt_depth.create(height, width, CV_32F);
     out.gt_valid.create(height, width, CV_8U);
+    out.gt_nonocc.create(height, width, CV_8U);
     out.gt_object_id.create(height, width, CV_16U);
 }
 
 TruthRow truthRow(RenderedFrame &out, int v) {
     return {out.gt_disparity.ptr<float>(v), out.gt_depth.ptr<float>(v), out.gt_valid.ptr<uint8_t>(v),
-            out.gt_object_id.ptr<uint16_t>(v)};
+            out.gt_nonocc.ptr<uint8_t>(v), out.gt_object_id.ptr<uint16_t>(v)};
 }
 
 } // namespace
@@ -397,8 +428,10 @@ Rgb Tracer::shade(const Vec3 &o, const Vec3 &d, const Hit &hit, const Vec3 &dir,
     return albedo * static_cast<float>(light);
 }
 
-cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, RenderedFrame *truth) const {
+cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, RenderedFrame *truth,
+                                 const Camera *rectifiedRight) const {
     const Tracer tracer(scene);
+    if (truth && !rectifiedRight) throw std::logic_error("Renderer::renderRadiance: truth asked without the rectified right imager");
     const int n = std::max(1, settings_.antialias * settings_.binning); // samples per axis on edges
     const Vec3 axis = cam.rotation.col(2);
     // Change of the (unnormalised) ray direction from one pixel to the next.
@@ -408,6 +441,7 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
     // and cylinders only), 12 the ground, 0 the sky.
     cv::Mat surface(cam.height, cam.width, CV_32F);
     if (truth) allocateTruth(*truth, cam.width, cam.height);
+    const TruthContext context{rig_, tracer, truth ? *rectifiedRight : cam, axis};
 
     // Pass 1: one ray through each pixel centre, texture filtered over the whole pixel.
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
@@ -425,7 +459,7 @@ cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, Rendered
                 const Rgb c = found ? tracer.shade(cam.center, d, hit, dir, stepX, stepY) : tracer.sky(d);
                 row[u] = cv::Vec3f(c.x(), c.y(), c.z());
                 ids[u] = found ? tracer.edgeId(hit) : 0.0f;
-                if (truth) gt.set(u, rig_, tracer, found, hit, d.dot(axis));
+                if (truth) gt.set(u, context, cam.center, d, found, hit);
             }
         }
     });
@@ -505,10 +539,11 @@ cv::Mat Renderer::expose(const cv::Mat &radiance, int imager, uint64_t frame) co
     return out;
 }
 
-void Renderer::renderGroundTruth(const Scene &scene, const Camera &cam, RenderedFrame &out) const {
+void Renderer::renderGroundTruth(const Scene &scene, const Camera &cam, const Camera &rectifiedRight,
+                                 RenderedFrame &out) const {
     const Tracer tracer(scene);
     allocateTruth(out, cam.width, cam.height);
-    const Vec3 axis = cam.rotation.col(2);
+    const TruthContext context{rig_, tracer, rectifiedRight, cam.rotation.col(2)};
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range &rows) {
         for (int v = rows.start; v < rows.end; ++v) {
             TruthRow gt = truthRow(out, v);
@@ -516,7 +551,7 @@ void Renderer::renderGroundTruth(const Scene &scene, const Camera &cam, Rendered
                 const Vec3 d = cam.ray(u, v);
                 Tracer::Hit hit;
                 const bool found = tracer.trace(cam.center, d, hit);
-                gt.set(u, rig_, tracer, found, hit, d.dot(axis));
+                gt.set(u, context, cam.center, d, found, hit);
             }
         }
     });
@@ -526,10 +561,11 @@ RenderedFrame Renderer::render(const Scene &scene, const RigPose &pose, uint64_t
     RenderedFrame out;
     if (rig_.settings().ideal()) {
         // The left imager is its own rectified image: its centre rays give the truth.
-        out.left = expose(renderRadiance(scene, rig_.left(pose), &out), 0, frame);
+        const Camera right = rig_.rectifiedRight(pose);
+        out.left = expose(renderRadiance(scene, rig_.left(pose), &out, &right), 0, frame);
     } else {
         out.left = expose(renderRadiance(scene, rig_.left(pose)), 0, frame);
-        renderGroundTruth(scene, rig_.rectifiedLeft(pose), out);
+        renderGroundTruth(scene, rig_.rectifiedLeft(pose), rig_.rectifiedRight(pose), out);
     }
     out.right = expose(renderRadiance(scene, rig_.right(pose)), 1, frame);
     return out;

@@ -30,6 +30,7 @@ struct RenderedFrame {
     cv::Mat gt_depth;               // CV_32F mm, depth along the rectified optical axis; 0 where nothing
     cv::Mat gt_valid;               // CV_8U, 255 where a surface was hit
     cv::Mat gt_object_id;           // CV_16U: Scene::kSkyId, kGroundId or SceneObject::id
+    cv::Mat gt_nonocc;              // CV_8U, 255 where the surface hit is also seen by the right imager
 };
 
 // Nearest-surface queries on a scene (ground plane, object bounds, analytic shapes).
@@ -79,11 +80,13 @@ public:
     RenderedFrame render(const Scene &scene, const RigPose &pose, uint64_t frame) const;
 
     // Linear radiance (CV_32FC3, RGB, 0..1) of one imager. When `truth` is given the
-    // camera must be the rectified left one, and the ground truth planes are filled from
-    // the same rays.
-    cv::Mat renderRadiance(const Scene &scene, const Camera &camera, RenderedFrame *truth = nullptr) const;
+    // camera must be the rectified left one, `rectifiedRight` its partner (for the
+    // occlusion mask), and the ground truth planes are filled from the same rays.
+    cv::Mat renderRadiance(const Scene &scene, const Camera &camera, RenderedFrame *truth = nullptr,
+                           const Camera *rectifiedRight = nullptr) const;
     // Ground truth alone, in the grid of the rectified left imager.
-    void renderGroundTruth(const Scene &scene, const Camera &rectifiedLeft, RenderedFrame &out) const;
+    void renderGroundTruth(const Scene &scene, const Camera &rectifiedLeft, const Camera &rectifiedRight,
+                           RenderedFrame &out) const;
 
     const RenderSettings &settings() const { return settings_; }
 

@@ -150,6 +150,16 @@ Camera StereoRig::rectifiedLeft(const RigPose &pose) const {
     return c;
 }
 
+Camera StereoRig::rectifiedRight(const RigPose &pose) const {
+    // x_rect = R2 x_r: the rectified axes in the left frame are rightAxes_ R2^T.
+    Camera c = camera(pose, rightAxes_ * toEigen(R2).transpose(), rightCentre_, Distortion{});
+    c.fx = P2.at<double>(0, 0);
+    c.fy = P2.at<double>(1, 1);
+    c.cx = P2.at<double>(0, 2);
+    c.cy = P2.at<double>(1, 2);
+    return c;
+}
+
 std::string StereoRig::calibrationYaml() const {
     cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     std::ostringstream configuration;

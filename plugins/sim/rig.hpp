@@ -69,6 +69,9 @@ public:
     Camera right(const RigPose &pose) const;
     // The left imager after rectification with calibration(): the grid of the ground truth.
     Camera rectifiedLeft(const RigPose &pose) const;
+    // Its partner: the right imager after rectification, the grid a matcher searches
+    // (a point at disparity d in rectifiedLeft's pixel (u, v) lands on (u - d, v)).
+    Camera rectifiedRight(const RigPose &pose) const;
     // Disparity of a point at depth z_mm (rectified left camera frame) in that grid.
     double rectifiedDisparity(double z_mm) const { return rectifiedFocalPx_ * rectifiedBaselineMm_ / z_mm + principalOffsetPx_; }
 

@@ -203,6 +203,7 @@ public:
         frame->extras = {{"gt_disparity", view(r.gt_disparity, BINOCLE_PIXEL_FLOAT32)},
                          {"gt_depth", view(r.gt_depth, BINOCLE_PIXEL_FLOAT32)},
                          {"gt_valid", view(r.gt_valid, BINOCLE_PIXEL_GRAY8)},
+                         {"gt_nonocc", view(r.gt_nonocc, BINOCLE_PIXEL_GRAY8)},
                          {"gt_object_id", view(r.gt_object_id, BINOCLE_PIXEL_GRAY16)}};
         frame->metadata = sim::frameMetadata(*scene, *rig_, pose, index);
         frame->owner = pixels;
