@@ -23,17 +23,6 @@ namespace {
 using sim::RenderSettings;
 using sim::RigSettings;
 
-// The misaligned, distorted head of the calibration tests.
-RigSettings imperfectRig() {
-    RigSettings s;
-    s.inclination_deg = 5;
-    s.distortion = {-0.12, 0.04, 0.0008, -0.0006, 0};
-    s.distortion_right = {-0.10, 0.03, -0.0005, 0.0007, 0};
-    s.right_rotation_deg = sim::Vec3(0.6, -0.5, 0.8);
-    s.right_offset_mm = sim::Vec3(1.5, -2.0, 3.0);
-    return s;
-}
-
 RenderSettings exact(int antialias) {
     RenderSettings r;
     r.noise_sigma = 0;

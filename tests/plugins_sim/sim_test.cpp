@@ -37,6 +37,8 @@ TEST(SimPlugin, DefaultFrameIsTheVidereHeadBeforeTheE1Panel) {
     EXPECT_EQ(f->extra("gt_depth").type(), CV_32FC1);
     EXPECT_EQ(f->extra("gt_valid").type(), CV_8UC1);
     EXPECT_EQ(f->extra("gt_object_id").type(), CV_16UC1);
+    EXPECT_EQ(f->extra("gt_nonocc").type(), CV_8UC1);
+    EXPECT_EQ(f->extra("gt_nonocc").size(), cv::Size(320, 240));
 
     const YAML::Node m = YAML::Load(f->metadata());
     EXPECT_DOUBLE_EQ(m["rig"]["baseline_mm"].as<double>(), 150);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Helpers of the sim tests: marker scenes, Eq. 1 written out independently of the
-// renderer, and blob centroids.
+// Helpers of the sim tests: a misaligned head, marker scenes, Eq. 1 written out
+// independently of the renderer, and blob centroids.
 #pragma once
 
 #include "renderer.hpp"
@@ -20,6 +20,17 @@ inline cv::Point3d groundToCamera(const cv::Point3d &g, double cameraHeightMm, d
     const double th = inclinationDeg * CV_PI / 180.0;
     const double a = g.y, b = cameraHeightMm - g.z; // Y = Zc cos - Yc sin; hc - Z = Zc sin + Yc cos
     return {g.x, -a * std::sin(th) + b * std::cos(th), a * std::cos(th) + b * std::sin(th)};
+}
+
+// The misaligned, distorted, inclined head of the calibration and occlusion tests.
+inline sim::RigSettings imperfectRig() {
+    sim::RigSettings s;
+    s.inclination_deg = 5;
+    s.distortion = {-0.12, 0.04, 0.0008, -0.0006, 0};
+    s.distortion_right = {-0.10, 0.03, -0.0005, 0.0007, 0};
+    s.right_rotation_deg = sim::Vec3(0.6, -0.5, 0.8);
+    s.right_offset_mm = sim::Vec3(1.5, -2.0, 3.0);
+    return s;
 }
 
 // A black world (no ground, black sky) with small bright squares facing the rig, their
