@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The sim source's renderer against cv::StereoSGBM (128 disparities, block 5) on the
-// same 640 x 480 pair, in the same run: the renderer must cost well under the matcher.
+// same 640 x 480 pair, in the same run: the renderer must cost well under the matcher;
+// and the occlusion mask's share of a frame.
 //   build/bench/binocle_bench --benchmark_filter=Sim
 #include "renderer.hpp"
 
@@ -70,6 +71,48 @@ BENCHMARK(BM_SimRenderVersusSgbm)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
+
+// The occlusion mask's share of a frame (gt_nonocc: one shadow ray per known pixel of
+// the ground truth, from the right optical centre towards the point the pixel sees).
+// One thread, in the same run: render_ms is a whole frame (mask included), mask_ms the
+// same tests made again, alone, on that frame's points; mask_over_rest = mask_ms /
+// (render_ms - mask_ms), the frame time the mask adds. Arg: scene (0 E1 panel, 1 E2 tree).
+void BM_SimOcclusionMaskShare(benchmark::State &state) {
+    const int threads = cv::getNumThreads();
+    cv::setNumThreads(1);
+    const binocle::sim::Scene world = scene(static_cast<int>(state.range(0)));
+    const binocle::sim::StereoRig rig(vga());
+    const binocle::sim::Renderer renderer(rig, binocle::sim::RenderSettings{});
+    const binocle::sim::Tracer tracer(world);
+    const binocle::sim::Camera left = rig.rectifiedLeft({}), right = rig.rectifiedRight({});
+    double render = 0, mask = 0;
+    uint64_t frame = 0;
+    for (auto _ : state) {
+        const auto t0 = Clock::now();
+        const binocle::sim::RenderedFrame f = renderer.render(world, {}, frame++);
+        const auto t1 = Clock::now();
+        int seen = 0;
+        for (int v = 0; v < f.gt_depth.rows; ++v)
+            for (int u = 0; u < f.gt_depth.cols; ++u) {
+                const float z = f.gt_depth.at<float>(v, u);
+                if (z <= 0) continue;
+                const bool ground = f.gt_object_id.at<uint16_t>(v, u) == binocle::sim::Scene::kGroundId;
+                seen += binocle::sim::seenBy(right, tracer, left.center + left.direction(u, v) * z, ground);
+            }
+        const auto t2 = Clock::now();
+        benchmark::DoNotOptimize(seen);
+        const double r = std::chrono::duration<double>(t1 - t0).count(), m = std::chrono::duration<double>(t2 - t1).count();
+        render += r;
+        mask += m;
+        state.SetIterationTime(r + m);
+    }
+    const double n = static_cast<double>(state.iterations());
+    state.counters["render_ms"] = 1e3 * render / n;
+    state.counters["mask_ms"] = 1e3 * mask / n;
+    state.counters["mask_over_rest"] = mask / (render - mask);
+    cv::setNumThreads(threads);
+}
+BENCHMARK(BM_SimOcclusionMaskShare)->ArgName("scene")->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 // Loading a scene, noise textures baked (a second load of the same scene reuses them).
 void BM_SimLoadScene(benchmark::State &state) {

@@ -153,20 +153,6 @@ inline Vec3 onTangentPlane(const Vec3 &o, const Vec3 &dir, const Vec3 &n, double
 // far below any surface's thickness, far above rounding).
 constexpr double kOcclusionTolerance = 1e-6;
 
-// Whether scene point p (met by a ray of the rectified left imager) is seen by the right
-// one: it lands inside the rectified right image, and the ray from the right optical
-// centre towards it meets no surface before it.
-bool seenBy(const Camera &right, const Tracer &tracer, const Vec3 &p) {
-    double u = 0, v = 0;
-    if (!right.project(p, u, v)) return false;
-    if (u < -0.5 || u > right.width - 0.5 || v < -0.5 || v > right.height - 0.5) return false;
-    const Vec3 toPoint = p - right.center;
-    const double distance = toPoint.norm();
-    Tracer::Hit hit;
-    // No hit at all: p lies on a surface seen from behind (the ground from below).
-    return tracer.trace(right.center, toPoint / distance, hit) && hit.t >= distance * (1 - kOcclusionTolerance);
-}
-
 // What the truth of one pixel is made from besides its ray.
 struct TruthContext {
     const StereoRig &rig;
@@ -187,7 +173,7 @@ struct TruthRow {
             disparity[u] = static_cast<float>(c.rig.rectifiedDisparity(z));
             valid[u] = 255;
             id[u] = c.tracer.objectId(h);
-            nonocc[u] = seenBy(c.right, c.tracer, origin + h.t * d) ? 255 : 0;
+            nonocc[u] = seenBy(c.right, c.tracer, origin + h.t * d, h.primitive < 0) ? 255 : 0;
         } else {
             depth[u] = 0;
             disparity[u] = -1.0f;
@@ -305,24 +291,29 @@ bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
         hit.face = 4;
         found = true;
     }
-    if (nodes_.empty()) {
-        hit.t = best;
-        return found;
-    }
+    found = traverse<false>(o, d, best, hit) || found;
+    hit.t = best;
+    return found;
+}
+
+bool Tracer::blocked(const Vec3 &o, const Vec3 &d, double tMax) const {
+    if (scene_.groundTexture >= 0 && d.z() < 0 && o.z() > 0 && -o.z() / d.z() < tMax) return true;
+    Hit hit;
+    return traverse<true>(o, d, tMax, hit);
+}
+
+template <bool AnyHit>
+bool Tracer::traverse(const Vec3 &o, const Vec3 &d, double &best, Hit &hit) const {
+    if (nodes_.empty()) return false;
     // Bounding sphere of everything first: most rays (sky, near ground) end here, before
     // the divisions of the slab tests.
     const Vec3 oc = rootCentre_ - o;
     const double b = oc.dot(d), c2 = oc.squaredNorm() - b * b;
-    if (c2 > rootRadius2_) {
-        hit.t = best;
-        return found;
-    }
+    if (c2 > rootRadius2_) return false;
     const double half = std::sqrt(rootRadius2_ - c2);
-    if (b + half < 0 || b - half > best) {
-        hit.t = best;
-        return found;
-    }
+    if (b + half < 0 || b - half > best) return false;
     const Vec3 inv = d.cwiseInverse();
+    bool found = false;
     int stack[64];
     int top = 0;
     stack[top++] = 0;
@@ -336,6 +327,7 @@ bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
                 double t = 0;
                 int face = 0;
                 if (hitPrimitive(i, o, d, inv, best, t, face)) {
+                    if (AnyHit) return true;
                     best = t;
                     hit.primitive = i;
                     hit.face = face;
@@ -355,7 +347,6 @@ bool Tracer::trace(const Vec3 &o, const Vec3 &d, Hit &hit) const {
             stack[top++] = second;
         }
     }
-    hit.t = best;
     return found;
 }
 
@@ -426,6 +417,16 @@ Rgb Tracer::shade(const Vec3 &o, const Vec3 &d, const Hit &hit, const Vec3 &dir,
     const double lambert = std::max(0.0, n.dot(scene_.light.direction));
     const double light = scene_.light.ambient + (1.0 - scene_.light.ambient) * lambert;
     return albedo * static_cast<float>(light);
+}
+
+bool seenBy(const Camera &right, const Tracer &tracer, const Vec3 &p, bool onGround) {
+    double u = 0, v = 0;
+    if (!right.project(p, u, v)) return false;
+    if (u < -0.5 || u > right.width - 0.5 || v < -0.5 || v > right.height - 0.5) return false;
+    if (onGround && right.center.z() <= 0) return false; // the ground is seen from above only
+    const Vec3 toPoint = p - right.center;
+    const double distance = toPoint.norm();
+    return !tracer.blocked(right.center, toPoint / distance, distance * (1 - kOcclusionTolerance));
 }
 
 cv::Mat Renderer::renderRadiance(const Scene &scene, const Camera &cam, RenderedFrame *truth,

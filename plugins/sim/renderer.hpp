@@ -45,6 +45,9 @@ public:
     explicit Tracer(const Scene &scene); // builds a bounding volume hierarchy of the primitives
     // Nearest surface along origin + t * direction (direction of unit length).
     bool trace(const Vec3 &origin, const Vec3 &direction, Hit &hit) const;
+    // Whether any surface lies along origin + t * direction with t < tMax (a shadow ray:
+    // the first one found ends the search, nothing beyond tMax is visited).
+    bool blocked(const Vec3 &origin, const Vec3 &direction, double tMax) const;
     // Light leaving the surface of `hit` towards the origin. dir: the ray's direction
     // with any length; dirDx, dirDy: its change across the sample's footprint (both
     // edges), which sets how much texture detail is filtered out.
@@ -63,6 +66,10 @@ private:
         int axis = 0;     // inner: the split axis, to visit the nearer child first
     };
     int build(int begin, int end);
+    // Walks the hierarchy for hits nearer than `best`: the nearest (best and hit updated),
+    // or with AnyHit the first found.
+    template <bool AnyHit>
+    bool traverse(const Vec3 &o, const Vec3 &d, double &best, Hit &hit) const;
     bool hitPrimitive(int index, const Vec3 &o, const Vec3 &d, const Vec3 &inv, double best, double &t, int &face) const;
 
     const Scene &scene_;
@@ -71,6 +78,12 @@ private:
     Vec3 rootCentre_{0, 0, 0}; // bounding sphere of the root's bounds
     double rootRadius2_ = 0;
 };
+
+// Whether scene point p (met by a ray of the rectified left imager; onGround: on the
+// ground plane) is seen by `right`, an undistorted imager (the rectified right one): it
+// lands inside its image, and the ray from its optical centre towards p meets no surface
+// before p. A point on the back of a solid is hidden by its front. What gt_nonocc holds.
+bool seenBy(const Camera &right, const Tracer &tracer, const Vec3 &p, bool onGround);
 
 class Renderer {
 public:
