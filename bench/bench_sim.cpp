@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -32,6 +33,28 @@ binocle::sim::Scene scene(int which) {
 
 cv::Ptr<cv::StereoSGBM> sgbm() { return cv::StereoSGBM::create(0, 128, 5, 8 * 25, 32 * 25, 1, 31, 10, 100, 2); }
 
+// The loop of a benchmark: each iteration renders a frame of `world`, then hands it to
+// `after`, both timed; the iteration time is the two. Returns their mean seconds.
+template <class After>
+std::pair<double, double> renderThen(benchmark::State &state, const binocle::sim::Renderer &renderer,
+                                     const binocle::sim::Scene &world, After after) {
+    double render = 0, rest = 0;
+    uint64_t frame = 0;
+    for (auto _ : state) {
+        const auto t0 = Clock::now();
+        const binocle::sim::RenderedFrame f = renderer.render(world, {}, frame++);
+        const auto t1 = Clock::now();
+        after(f);
+        const auto t2 = Clock::now();
+        const double r = std::chrono::duration<double>(t1 - t0).count(), m = std::chrono::duration<double>(t2 - t1).count();
+        render += r;
+        rest += m;
+        state.SetIterationTime(r + m);
+    }
+    const double n = static_cast<double>(state.iterations());
+    return {render / n, rest / n};
+}
+
 // Args: scene (0 E1 panel, 1 E2 tree), threads (0: OpenCV's default, else that many).
 // Reports render_ms, sgbm_ms and their ratio; iteration time = render + match.
 void BM_SimRenderVersusSgbm(benchmark::State &state) {
@@ -41,24 +64,13 @@ void BM_SimRenderVersusSgbm(benchmark::State &state) {
     const binocle::sim::StereoRig rig(vga());
     const binocle::sim::Renderer renderer(rig, binocle::sim::RenderSettings{});
     const cv::Ptr<cv::StereoSGBM> matcher = sgbm();
-    double render = 0, match = 0;
-    uint64_t frame = 0;
     cv::Mat disparity;
-    for (auto _ : state) {
-        const auto t0 = Clock::now();
-        const binocle::sim::RenderedFrame f = renderer.render(world, {}, frame++);
-        const auto t1 = Clock::now();
+    const auto [render, match] = renderThen(state, renderer, world, [&](const binocle::sim::RenderedFrame &f) {
         matcher->compute(f.left, f.right, disparity);
-        const auto t2 = Clock::now();
         benchmark::DoNotOptimize(disparity.data);
-        const double r = std::chrono::duration<double>(t1 - t0).count(), m = std::chrono::duration<double>(t2 - t1).count();
-        render += r;
-        match += m;
-        state.SetIterationTime(r + m);
-    }
-    const double n = static_cast<double>(state.iterations());
-    state.counters["render_ms"] = 1e3 * render / n;
-    state.counters["sgbm_ms"] = 1e3 * match / n;
+    });
+    state.counters["render_ms"] = 1e3 * render;
+    state.counters["sgbm_ms"] = 1e3 * match;
     state.counters["render_over_sgbm"] = render / match;
     state.counters["threads"] = cv::getNumThreads();
     cv::setNumThreads(threads);
@@ -85,12 +97,7 @@ void BM_SimOcclusionMaskShare(benchmark::State &state) {
     const binocle::sim::Renderer renderer(rig, binocle::sim::RenderSettings{});
     const binocle::sim::Tracer tracer(world);
     const binocle::sim::Camera left = rig.rectifiedLeft({}), right = rig.rectifiedRight({});
-    double render = 0, mask = 0;
-    uint64_t frame = 0;
-    for (auto _ : state) {
-        const auto t0 = Clock::now();
-        const binocle::sim::RenderedFrame f = renderer.render(world, {}, frame++);
-        const auto t1 = Clock::now();
+    const auto [render, mask] = renderThen(state, renderer, world, [&](const binocle::sim::RenderedFrame &f) {
         int seen = 0;
         for (int v = 0; v < f.gt_depth.rows; ++v)
             for (int u = 0; u < f.gt_depth.cols; ++u) {
@@ -99,16 +106,10 @@ void BM_SimOcclusionMaskShare(benchmark::State &state) {
                 const bool ground = f.gt_object_id.at<uint16_t>(v, u) == binocle::sim::Scene::kGroundId;
                 seen += binocle::sim::seenBy(right, tracer, left.center + left.direction(u, v) * z, ground);
             }
-        const auto t2 = Clock::now();
         benchmark::DoNotOptimize(seen);
-        const double r = std::chrono::duration<double>(t1 - t0).count(), m = std::chrono::duration<double>(t2 - t1).count();
-        render += r;
-        mask += m;
-        state.SetIterationTime(r + m);
-    }
-    const double n = static_cast<double>(state.iterations());
-    state.counters["render_ms"] = 1e3 * render / n;
-    state.counters["mask_ms"] = 1e3 * mask / n;
+    });
+    state.counters["render_ms"] = 1e3 * render;
+    state.counters["mask_ms"] = 1e3 * mask;
     state.counters["mask_over_rest"] = mask / (render - mask);
     cv::setNumThreads(threads);
 }
