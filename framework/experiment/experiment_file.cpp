@@ -275,7 +275,6 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
 // Frames, lenses, baselines, the sensor figures, the matcher's search and the panel.
 void readHead(Experiment &e, const YAML::Node &root, const Reader &r, const PluginHost &host) {
     if (root["frames"]) e.frames = r.integer(root["frames"], "frames", 1, 1000000);
-
     if (root["lenses_mm"]) e.lenses_mm = r.numbers(root["lenses_mm"], "lenses_mm");
     if (root["baseline_range_mm"]) {
         auto b = r.numbers(root["baseline_range_mm"], "baseline_range_mm");

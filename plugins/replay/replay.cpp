@@ -433,7 +433,8 @@ std::string detectLayout(const Settings &s) {
     throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                 "replay: folder " + inQuotes(folder) +
                     " holds none of the known layouts: frames.csv (recording), a stereo pair im0/im1, view1/view5, "
-                    "imL/imR, im2/im6 or left/right (middlebury scene, also in sub-folders), image_2/ and image_3/ (kitti), metadata.yaml or *.mcap (mcap); set `layout` "
+                    "imL/imR, im2/im6 or left/right (middlebury scene, also in sub-folders), image_2/ and image_3/ "
+                    "(kitti), metadata.yaml or *.mcap (mcap); set `layout` "
                     "or use `left`/`right` patterns");
 }
 

@@ -144,7 +144,7 @@ FrameFiles sceneFrame(const fs::path &folder, double givenScale) {
     }
     if (f.left.empty())
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder " + inQuotes(folder) +
-                                               " holds no stereo pair: expected im0/im1, view1/view5, imL/imR, im2/im6 or "
+                                               " holds no stereo pair: expected im0.png/im1.png, view1/view5, imL/imR, im2/im6 or "
                                                "left/right images");
     f.facts.emplace_back("scene", folder.filename().string());
     const TruthName *truth = nullptr;
@@ -199,7 +199,7 @@ std::vector<fs::path> sceneFolders(const std::string &folder) {
             if (!isSceneFolder(p))
                 throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder pattern '" + folder + "' matched " + inQuotes(p) +
                                                        ", which holds no stereo pair; expected scene folders "
-                                                       "(im0/im1, view1/view5, imL/imR, im2/im6 or left/right)");
+                                                       "(im0.png/im1.png, view1/view5, imL/imR, im2/im6 or left/right)");
         return scenes;
     }
     if (!fs::is_directory(folder))
@@ -209,7 +209,7 @@ std::vector<fs::path> sceneFolders(const std::string &folder) {
         if (isSceneFolder(p)) scenes.push_back(std::move(p));
     if (scenes.empty())
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder '" + folder +
-                                               "' holds no stereo pair (im0/im1, view1/view5, imL/imR, im2/im6 or "
+                                               "' holds no stereo pair (im0.png/im1.png, view1/view5, imL/imR, im2/im6 or "
                                                "left/right), nor any sub-folder that does; expected a scene folder");
     return scenes;
 }

@@ -2,6 +2,7 @@
 // The `disparity` evaluator's figures against figures computed by hand on an 8 x 2 image:
 // Middlebury's bad-0.5/1/2/4, avgerr, rms, invalid % over non-occluded and all pixels
 // (holes counted as errors in the bad rates), KITTI's D1 on the background-filled map.
+#include "config/rig_config.hpp"
 #include "host/plugin_host.hpp"
 
 #include <gtest/gtest.h>
@@ -28,10 +29,10 @@ const PluginRecord &disparityRecord() {
     return host->require("disparity", BINOCLE_KIND_EVALUATOR);
 }
 
-struct Run {
+struct EvalRun {
     std::map<std::string, double> metrics;
     std::unique_ptr<Evaluator> evaluator;
-    explicit Run(const std::string &yaml = "{}") {
+    explicit EvalRun(const std::string &yaml = "{}") {
         HostSink sink;
         sink.metric = [this](const std::string &n, double v, const std::string &) { metrics[n] = v; };
         sink.log = [](int32_t, const std::string &) {};
@@ -86,7 +87,7 @@ struct Frame {
 // Errors of the 12 matched pixels: 0.2 1.0 0 3.5 0.4 0 | 0 0.6 5.0 0 4.5 0; of the 10
 // non-occluded ones: the same less 3.5 and 5.0.
 TEST(DisparityEvaluator, MiddleburyAndKittiFiguresAsComputedByHand) {
-    Run run;
+    EvalRun run;
     Frame frame(true);
     run.evaluator->evaluate(frame.in);
     auto &m = run.metrics;
@@ -123,7 +124,7 @@ TEST(DisparityEvaluator, MiddleburyAndKittiFiguresAsComputedByHand) {
 }
 
 TEST(DisparityEvaluator, WithoutGtNonoccTheNonoccFiguresAreAbsent) {
-    Run run("{thresholds_px: [3]}");
+    EvalRun run("{thresholds_px: [3]}");
     Frame frame(false);
     run.evaluator->evaluate(frame.in);
     EXPECT_EQ(run.metrics.count("bad_3px_nonocc_percent"), 0u);
@@ -134,7 +135,7 @@ TEST(DisparityEvaluator, WithoutGtNonoccTheNonoccFiguresAreAbsent) {
 }
 
 TEST(DisparityEvaluator, AGroundTruthBeyondTheWidthOrBadThresholdsAreRefused) {
-    Run run;
+    EvalRun run;
     Frame frame(true, 255.0f); // what a PFM read by its -1/255 scale's magnitude gives
     try {
         run.evaluator->evaluate(frame.in);
@@ -142,8 +143,8 @@ TEST(DisparityEvaluator, AGroundTruthBeyondTheWidthOrBadThresholdsAreRefused) {
     } catch (const std::exception &e) {
         EXPECT_NE(std::string(e.what()).find("image width 8"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(Run("{thresholds_px: [1, x]}"), std::exception);
-    EXPECT_THROW(Run("{thresholds_px: [-1]}"), std::exception);
+    EXPECT_THROW(EvalRun("{thresholds_px: [1, x]}"), std::exception);
+    EXPECT_THROW(EvalRun("{thresholds_px: [-1]}"), std::exception);
 }
 
 } // namespace

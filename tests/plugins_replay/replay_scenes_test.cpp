@@ -263,8 +263,8 @@ TEST_F(Scenes, SharedStereoGtPairsAtTheirManifestScale) {
     while (auto f = src->grab()) {
         const YAML::Node m = metadataOf(*f);
         YAML::Node pair;
-        for (const auto &p : manifest)
-            if (p["name"].as<std::string>() == m["scene"].as<std::string>()) pair = p;
+        for (const YAML::Node p : manifest)
+            if (p["name"].as<std::string>() == m["scene"].as<std::string>()) pair.reset(p);
         ASSERT_TRUE(pair) << m["scene"];
         EXPECT_EQ(m["ground_truth_divisor"].as<double>(), pair["gt_scale"].as<double>()) << pair["name"];
         const bool masked = pair["masks"].IsMap() && pair["masks"].size() > 0;
