@@ -31,7 +31,7 @@ const std::vector<std::string> kTopKeys = {
     "name",    "description", "rig",        "frames",     "lenses_mm",         "baseline_range_mm", "pixel_pitch_um",
     "image_width_px", "image_height_px", "disparity_search_px", "bind", "defaults", "tests", "charts", "repeats",
     "seed",    "seeds",       "seed_path",  "jitter",     "calibration",       "board_calibration", "lens_table", "panel",
-    "rig_set", "dataset",   "dataset_path", "scenes",   "matcher"};
+    "rig_set", "dataset",   "dataset_path", "scenes",   "scene_set", "matcher"};
 const std::vector<std::string> kTestKeys = {"id", "baseline_mm", "focal_length_mm", "range_mm", "camera_height_mm",
                                             "inclination_deg", "set", "repeats", "paper"};
 
@@ -231,11 +231,19 @@ YAML::Node datasetTests(const YAML::Node &root, const Reader &r) {
     } else {
         for (const auto &n : names) scenes.push_back(folder / n);
     }
+    // scene_set: {SCENE: {rig path: value}}: what one scene needs of its own (its search range).
+    const YAML::Node own = root["scene_set"];
+    if (own && !own.IsMap()) r.fail(own, "scene_set: expected a map scene -> {rig path: value}");
     YAML::Node tests(YAML::NodeType::Sequence);
     for (const fs::path &scene : scenes) {
         YAML::Node t;
-        t["id"] = scene.filename().string();
+        const std::string id = scene.filename().string();
+        t["id"] = id;
         t["set"][path] = scene.string();
+        if (own && own[id]) {
+            if (!own[id].IsMap()) r.fail(own[id], "scene_set." + id + ": expected a map {rig path: value}");
+            for (const auto &kv : own[id]) t["set"][r.text(kv.first, "scene_set." + id)] = kv.second;
+        }
         tests.push_back(t);
     }
     return tests;

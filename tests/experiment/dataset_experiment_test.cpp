@@ -97,6 +97,9 @@ TEST(DatasetExperiment, MatcherSwapsTheRigsMatcherBlockAndBadValuesAreRefused) {
     EXPECT_EQ(rig["matcher"]["num_disparities"].as<int>(), 32);
     EXPECT_FALSE(rig["matcher"]["block_size"]) << "the whole block is replaced, not merged";
     EXPECT_EQ(rig["source"]["folder"].as<std::string>(), dir.str("data/s"));
+    // scene_set: a scene's own settings, over the swapped matcher.
+    e = loadExperiment(dir.str("bench.yaml"), host, {"scene_set={s: {matcher.num_disparities: 48}}"});
+    EXPECT_EQ(rigForTest(e, e.tests.front())["matcher"]["num_disparities"].as<int>(), 48);
     auto errorOf = [&](const std::vector<std::string> &set) {
         try {
             loadExperiment(dir.str("bench.yaml"), host, set);
