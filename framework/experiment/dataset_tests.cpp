@@ -5,6 +5,8 @@
 
 #include "report/chart.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -39,7 +41,8 @@ void writeSceneCharts(const std::string &dir, const Experiment &e, const std::ve
         BarChart c;
         c.title = spec.title.empty() ? e.name + ": " + spec.metric : spec.title;
         c.y_label = spec.metric;
-        c.series = {spec.metric.substr(spec.metric.find('.') + 1)};
+        const YAML::Node matcher = e.rig["matcher"]; // the legend: the matcher the rig runs
+        c.series = {matcher.IsMap() && matcher["plugin"].IsScalar() ? matcher["plugin"].Scalar() : e.name};
         c.reference_lines = spec.reference_lines;
         double most = 0;
         for (const auto &r : rows) {
@@ -52,7 +55,8 @@ void writeSceneCharts(const std::string &dir, const Experiment &e, const std::ve
             continue;
         }
         const bool percent = spec.metric.size() > 8 && spec.metric.compare(spec.metric.size() - 8, 8, "_percent") == 0;
-        c.y_max = percent ? 100 : std::max(1.0, std::ceil(most * 1.1));
+        // The axis fits the data (percentages in steps of 10, at most 100).
+        c.y_max = percent ? std::min(100.0, std::max(10.0, 10 * std::ceil(most * 1.1 / 10))) : std::max(1.0, std::ceil(most * 1.1));
         writeChart((fs::path(dir) / spec.file).string(), c);
     }
 }
