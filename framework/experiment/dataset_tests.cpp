@@ -3,6 +3,8 @@
 // means; a bar chart per metric, one bar per scene and one for the mean.
 #include "experiment/dataset_tests.hpp"
 
+#include "experiment/charts.hpp"
+
 #include "report/chart.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -59,6 +61,15 @@ void writeSceneCharts(const std::string &dir, const Experiment &e, const std::ve
         c.y_max = percent ? std::min(100.0, std::max(10.0, 10 * std::ceil(most * 1.1 / 10))) : std::max(1.0, std::ceil(most * 1.1));
         writeChart((fs::path(dir) / spec.file).string(), c);
     }
+}
+
+void finishRows(const std::string &dir, const Experiment &e, std::vector<Row> &rows, const ExperimentTest &mean) {
+    if (!e.dataset_tests) {
+        writeCharts(dir, e, rows);
+        return;
+    }
+    rows.push_back(meanRow(rows, mean));
+    writeSceneCharts(dir, e, rows);
 }
 
 } // namespace binocle::experiment

@@ -238,6 +238,7 @@ YAML::Node datasetTests(const YAML::Node &root, const Reader &r) {
     for (const fs::path &scene : scenes) {
         YAML::Node t;
         const std::string id = scene.filename().string();
+        if (id == "mean") r.fail(d, "dataset: " + scene.string() + ": a scene may not be named 'mean' (the row of the means)");
         t["id"] = id;
         t["set"][path] = scene.string();
         if (own && own[id]) {

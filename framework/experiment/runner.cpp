@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Running an experiment: each selected test's repeats through the rig's pipeline, a row
 // per test, the tables rewritten after every test and the charts at the end.
-#include "experiment/charts.hpp"
 #include "experiment/dataset_tests.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/results.hpp"
@@ -316,12 +315,7 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     }
     progress.update(static_cast<int64_t>(selected.size()), "done");
     progress.finish();
-    if (e.dataset_tests) {
-        rows.push_back(meanRow(rows, meanTest));
-        writeSceneCharts(options.out_dir, e, rows);
-    } else {
-        writeCharts(options.out_dir, e, rows);
-    }
+    finishRows(options.out_dir, e, rows, meanTest);
     meta.status = selected.size() == e.tests.size() ? kStatusComplete : kStatusPartial;
     writeTables(options.out_dir, e, rows, meta); // last: the status says the charts are there too
     ExperimentResult result = resultOf(rows);

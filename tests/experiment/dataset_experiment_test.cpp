@@ -79,6 +79,18 @@ TEST(DatasetExperiment, ARowPerSceneThenTheMeansAndABarPerScene) {
     r = runCli("experiment " + dir.str("bench.yaml") + " --quiet --set 'scenes=[b-scene]' --out " + dir.str("one"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(csv(dir.str("one/results.csv")).size(), 3u);
+    // Shards merge into the same table, the means made again over all the scenes.
+    for (const char *k : {"1", "2"}) {
+        r = runCli("experiment " + dir.str("bench.yaml") + " --quiet --shard " + k + "/2 --out " + dir.str(std::string("shard") + k));
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    r = runCli("experiment merge " + dir.str("merged") + " " + dir.str("shard1") + " " + dir.str("shard2"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto merged = csv(dir.str("merged/results.csv"));
+    ASSERT_EQ(merged.size(), 4u);
+    EXPECT_EQ(merged[3][0], "mean");
+    EXPECT_NEAR(std::stod(merged[3][col]), (a + b) / 2, 1e-6);
+
     r = runCli("experiment " + dir.str("bench.yaml") + " --quiet --set 'scenes=[c-scene]' --out " + dir.str("none"));
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.output.find("'c-scene' is not a folder of"), std::string::npos) << r.output;
