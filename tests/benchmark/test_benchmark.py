@@ -141,14 +141,24 @@ def test_benchmark_experiment_gives_a_row_per_scene_the_means_charts_and_report(
 
 
 @needs_shared
-def test_kitti_benchmark_gives_d1(tmp_path):
+def test_kitti_benchmark_gives_d1_on_a_training_tree(tmp_path):
+    # A KITTI 2012 training tree of symlinks to the shared pair, made into scene folders
+    # by scripts/kitti-scene-folders.sh, then the benchmark on them.
+    tree, pair = tmp_path / "training", os.path.join(SHARED, "kitti2012-000070")
+    for folder, target in (("image_0", "left.png"), ("image_1", "right.png"),
+                           ("disp_occ", "disp_occ_000070_10.png"), ("disp_noc", "disp_noc_000070_10.png")):
+        (tree / folder).mkdir(parents=True)
+        os.symlink(os.path.join(pair, target), tree / folder / "000070_10.png")
+    r = subprocess.run(["sh", os.path.join(SOURCE_DIR, "scripts/kitti-scene-folders.sh"), str(tree), str(tmp_path / "pairs")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0 and "1 pairs" in r.stdout, r.stderr
     out = tmp_path / "kitti"
     binocle("experiment", os.path.join(SOURCE_DIR, "configs/experiments/benchmark-kitti.yaml"),
-            "--set", f"dataset={SHARED}", "--set", "matcher={plugin: bm, num_disparities: 160, block_size: 9}",
-            "--out", str(out), "--quiet")
+            "--set", f"dataset={tmp_path / 'pairs'}", "--set", "scenes=[]",
+            "--set", "matcher={plugin: bm, num_disparities: 160, block_size: 9}", "--out", str(out), "--quiet")
     with open(out / "results.csv") as f:
         rows = list(csv.DictReader(f))
-    assert [r["test"] for r in rows] == ["kitti2012-000070", "mean"]
+    assert [r["test"] for r in rows] == ["000070_10", "mean"]
     d1 = float(rows[0]["disparity.d1_all_percent"])
     assert 0 < d1 < 100
     assert rows[0]["disparity.d1_noc_percent"] != ""  # the disp_noc ground truth gives the non-occluded pixels
