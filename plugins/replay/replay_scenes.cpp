@@ -29,7 +29,9 @@ struct PairNames {
     const char *left, *right;
 };
 // In the order looked for; the first pair present names the scene's images.
-constexpr PairNames kPairs[] = {{"im0", "im1"}, {"view1", "view5"}, {"imL", "imR"}, {"im2", "im6"}, {"left", "right"}};
+constexpr PairNames kPairs[] = {{"im0", "im1"},   {"view1", "view5"}, {"imL", "imR"}, {"im2", "im6"},
+                                 {"scene1.row3.col3", "scene1.row3.col4"}, // Tsukuba as first published
+                                 {"left", "right"}};
 
 fs::path imageNamed(const fs::path &folder, const std::string &stem) {
     for (const char *ext : {".png", ".ppm", ".pgm", ".jpg", ".bmp", ".tif"})
@@ -57,6 +59,7 @@ constexpr TruthName kTruths[] = {
     {"groundtruth.png", Rule::BySizeV2, "middlebury-2001/2003"}, // the v2 evaluation's name
     {"disp2.png", Rule::BySizeV2, "middlebury-2001/2003"},
     {"disp2.pgm", Rule::BySizeV2, "middlebury-2001/2003"},
+    {"truedisp.row3.col3.pgm", Rule::BySizeV2, "middlebury-2001/2003"}, // Tsukuba as first published
 };
 
 // The factor the stored values are divided by, from the left image's size.

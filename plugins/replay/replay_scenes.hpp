@@ -16,7 +16,7 @@ namespace binocle::replay {
 
 // True when the folder holds a stereo pair under one of the dataset names: im0/im1
 // (Middlebury 2014, MiddEval3), view1/view5 (2005, 2006), imL/imR (the v2 evaluation's
-// 2001/2003 scenes), im2/im6 (2001, 2003), left/right.
+// 2001/2003 scenes), im2/im6 (2001, 2003), scene1.row3.col3/col4 (Tsukuba), left/right.
 bool isSceneFolder(const std::filesystem::path &folder);
 
 // The scene folders `folder` names: a scene, a folder whose sub-folders are scenes (in
@@ -24,8 +24,8 @@ bool isSceneFolder(const std::filesystem::path &folder);
 std::vector<std::filesystem::path> sceneFolders(const std::string &folder);
 
 // The frame of one scene folder: the pair, the ground truth found by its dataset name
-// (disp0GT.pfm, disp0.pfm, disp1.png, groundtruth.png, disp2.png|pgm, disp_occ*.png,
-// disp_noc*.png), its scale by the dataset's rule, the masks, and the facts `dataset`,
+// (disp0GT.pfm, disp0.pfm, disp1.png, groundtruth.png, disp2.png|pgm,
+// truedisp.row3.col3.pgm, disp_occ*.png, disp_noc*.png), its scale by the dataset's rule, the masks, and the facts `dataset`,
 // `ground_truth_divisor`. `givenScale` > 0 (`ground_truth_scale` set) replaces the rule.
 // Throws sdk::Error naming the folder when the pair is incomplete or the rule does not
 // know the image's size.

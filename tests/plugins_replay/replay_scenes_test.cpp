@@ -199,6 +199,14 @@ TEST_F(Scenes, Middlebury2001And2003Im2Im6ByTheirSizes) {
         EXPECT_FLOAT_EQ(f->extra("gt_disparity").at<float>(0, 0), 120.0f / static_cast<float>(divisor)) << h;
         EXPECT_EQ(f->raw().extra_count, 2) << "no masks in a 2001/2003 scene folder";
     }
+    // Tsukuba as first published: PPM views, a PGM ground truth x16.
+    writePair(path("tsukuba"), "scene1.row3.col3.ppm", "scene1.row3.col4.ppm", {384, 288});
+    write(path("tsukuba/truedisp.row3.col3.pgm"), cv::Mat(288, 384, CV_8UC1, cv::Scalar(7 * 16)));
+    auto src = open("{folder: " + path("tsukuba").string() + ", nominal_calibration: true}");
+    auto f = grabOne(*src);
+    ASSERT_TRUE(f);
+    EXPECT_FLOAT_EQ(f->extra("gt_disparity").at<float>(5, 5), 7.0f);
+    EXPECT_EQ(metadataOf(*f)["ground_truth_divisor"].as<double>(), 16.0);
 }
 
 TEST_F(Scenes, KittiPairFolderAnd2012TreeGiveNocAsGtNonocc) {
