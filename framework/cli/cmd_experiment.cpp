@@ -83,13 +83,16 @@ Register experimentCommand{{"experiment", "run an experiment (E1, E2 of METHOD.m
               "<figure>_sd and the 95 % confidence interval <figure>_ci95_low/_high; charts carry\n"
               "error bars. calibration: board calibrates every configuration from chessboard pairs\n"
               "first. results.json holds Spearman's rho of each predictor against η3D.\n"
-              "`binocle experiment merge OUT DIR...` joins the folders of --shard runs.",
+              "`binocle experiment merge OUT DIR...` joins the folders of --shard runs.\n\n"
+              "Over a dataset (dataset: FOLDER, the benchmarks configs/experiments/benchmark-*.yaml):\n"
+              "a test per scene folder, a row per scene and a row `mean`, a bar per scene;\n"
+              "--set dataset=DIR --set 'matcher={plugin: NAME, ...}' measures any matcher.",
               define<ExperimentArgs>(
                   [](CLI::App &app, ExperimentArgs &args) {
                       app.add_option("file", args.file, "the experiment file (YAML)")->type_name("FILE");
                       app.add_option("--set", args.set,
                                      "change a key of the experiment file (repeats=10, calibration=board, "
-                                     "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640); repeatable")
+                                     "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640, dataset=DIR, matcher=sgm); repeatable")
                           ->type_name("KEY=VALUE")
                           ->allow_extra_args(false);
                       app.add_option("--shard", args.shard,

@@ -70,13 +70,7 @@ void writePfm(const std::string &path, const cv::Mat &image) {
         out = image.clone();
         out.setTo(std::numeric_limits<float>::infinity(), ~(image > 0) & (image == image));
     }
-    std::vector<uchar> bytes;
-    try {
-        if (!cv::imencode(".pfm", out, bytes)) throw Error(path + ": cannot encode PFM");
-    } catch (const cv::Exception &e) {
-        throw Error(path + ": cannot encode PFM: " + e.err);
-    }
-    writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
+    writeFileAtomic(path, input::encodePfm(out)); // the one PFM writer: scale -1, little-endian
 }
 
 cv::Mat readPfm(const std::string &path) {

@@ -67,6 +67,9 @@ struct Experiment {
     std::string rig_text;
     std::vector<std::pair<std::string, std::string>> rig_set;
     int64_t frames = 1;
+    // `dataset:` (the benchmarks): a test per scene folder of the dataset, named after it,
+    // no geometry; a row of the means after the scenes (dataset_tests.hpp).
+    bool dataset_tests = false;
     std::vector<double> lenses_mm;            // the focal lengths the rig has
     double baseline_min_mm = 0, baseline_max_mm = 0;
     // The head's sensor and matcher (method::StereoDesign, the one head description):

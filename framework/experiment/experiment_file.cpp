@@ -31,7 +31,7 @@ const std::vector<std::string> kTopKeys = {
     "name",    "description", "rig",        "frames",     "lenses_mm",         "baseline_range_mm", "pixel_pitch_um",
     "image_width_px", "image_height_px", "disparity_search_px", "bind", "defaults", "tests", "charts", "repeats",
     "seed",    "seeds",       "seed_path",  "jitter",     "calibration",       "board_calibration", "lens_table", "panel",
-    "rig_set"};
+    "rig_set", "dataset",   "dataset_path", "scenes",   "scene_set", "matcher"};
 const std::vector<std::string> kTestKeys = {"id", "baseline_mm", "focal_length_mm", "range_mm", "camera_height_mm",
                                             "inclination_deg", "set", "repeats", "paper"};
 
@@ -183,6 +183,73 @@ YAML::Node readRoot(const Experiment &e, const std::string &file, const std::vec
     return root;
 }
 
+// `matcher:` replaces the rig's matcher block for every test (`--set matcher=bm`, or a map
+// with the plugin's settings); it goes into rig_set, so that every test's rig gets it.
+void layMatcher(Experiment &e, const YAML::Node &root, const Reader &r) {
+    auto lay = [&](const YAML::Node &at, const std::string &path, const std::string &value) {
+        try {
+            applyOverride(e.rig, Override{path, value, path + "=" + value});
+            e.rig_set.emplace_back(path, value);
+        } catch (const OverrideError &x) {
+            r.fail(at, std::string(x.what()) + " (laid over the base rig " + e.rig_file + ")");
+        }
+    };
+    if (const YAML::Node m = root["matcher"]) {
+        if (m.IsScalar()) lay(m, "matcher", "{plugin: " + m.Scalar() + "}");
+        else if (m.IsMap() && m["plugin"]) lay(m, "matcher", yamlText(m));
+        else r.fail(m, "matcher: expected a plugin name (matcher=bm) or a map {plugin: NAME, its settings}");
+    }
+}
+
+// `dataset:` a folder of scene folders (relative: from the current folder, as a
+// command-line path): a test per sub-folder, in natural order, named after it, that writes
+// the scene's folder to the rig path `dataset_path` (default source.folder); `scenes:`
+// picks some by name. A folder without sub-folders is one scene itself.
+YAML::Node datasetTests(const YAML::Node &root, const Reader &r) {
+    if (root["tests"]) r.fail(root["tests"], "tests: not with dataset: (its scene folders are the tests)");
+    const YAML::Node d = root["dataset"];
+    const std::string path = root["dataset_path"] ? r.text(root["dataset_path"], "dataset_path") : "source.folder";
+    std::error_code ec;
+    const fs::path folder = fs::absolute(r.text(d, "dataset"), ec).lexically_normal();
+    if (!fs::is_directory(folder))
+        r.fail(d, "dataset: folder '" + folder.string() + "' does not exist (a relative path is taken from the current folder)");
+    std::vector<std::string> names;
+    for (const auto &entry : fs::directory_iterator(folder, ec))
+        if (entry.is_directory() && entry.path().filename().string()[0] != '.') names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    std::vector<fs::path> scenes;
+    if (names.empty()) scenes.push_back(folder);
+    if (const YAML::Node pick = root["scenes"]; pick && !(pick.IsSequence() && pick.size() == 0)) {
+        if (!pick.IsSequence()) r.fail(pick, "scenes: expected a list of scene folder names, e.g. [teddy, cones]");
+        for (const auto &n : pick) {
+            const std::string name = r.text(n, "scenes");
+            if (std::find(names.begin(), names.end(), name) == names.end())
+                r.fail(n, "scenes: '" + input::printable(name) + "' is not a folder of " + folder.string() + " (its folders: " +
+                              join(names) + ")");
+            scenes.push_back(folder / name);
+        }
+    } else {
+        for (const auto &n : names) scenes.push_back(folder / n);
+    }
+    // scene_set: {SCENE: {rig path: value}}: what one scene needs of its own (its search range).
+    const YAML::Node own = root["scene_set"];
+    if (own && !own.IsMap()) r.fail(own, "scene_set: expected a map scene -> {rig path: value}");
+    YAML::Node tests(YAML::NodeType::Sequence);
+    for (const fs::path &scene : scenes) {
+        YAML::Node t;
+        const std::string id = scene.filename().string();
+        if (id == "mean") r.fail(d, "dataset: " + scene.string() + ": a scene may not be named 'mean' (the row of the means)");
+        t["id"] = id;
+        t["set"][path] = scene.string();
+        if (own && own[id]) {
+            if (!own[id].IsMap()) r.fail(own[id], "scene_set." + id + ": expected a map {rig path: value}");
+            for (const auto &kv : own[id]) t["set"][r.text(kv.first, "scene_set." + id)] = kv.second;
+        }
+        tests.push_back(t);
+    }
+    return tests;
+}
+
 // The base rig, with `rig_set:` laid over it.
 void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
     if (!root["rig"] || !root["rig"].IsScalar()) throw Error(e.file + ": missing key 'rig' (the base rig file)");
@@ -193,6 +260,7 @@ void readRig(Experiment &e, const YAML::Node &root, const Reader &r) {
     e.rig = loadYaml(e.rig_file);
     e.rig_text = readTextFile(e.rig_file);
     checkRigShape(e.rig, e.rig_file, r.where(root["rig"]) + ": rig");
+    layMatcher(e, root, r);
     // rig_set: a partial rig laid over the base rig for every test (variants of a whole
     // experiment: `--set rig_set.source.image_width=640`).
     if (YAML::Node rs = root["rig_set"]) {
@@ -426,7 +494,7 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
     for (const auto &var : kVariables) {
         if (tn[var]) {
             *field(t.geometry, var) = r.number(tn[var], "test " + t.id + ": " + var);
-        } else if (!defaults.given.count(var) && var != "inclination_deg" && var != "camera_height_mm") {
+        } else if (!defaults.given.count(var) && var != "inclination_deg" && var != "camera_height_mm" && !e.dataset_tests) {
             r.fail(tn, "test " + t.id + ": no " + var + " (set it in the test, in defaults:, or in the base rig)");
         }
     }
@@ -447,7 +515,7 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
     if (!e.lens_table.empty() && !lensFor(e, t.geometry.focal_length_mm))
         r.fail(tn, "test " + t.id + ": focal_length_mm = " + num(t.geometry.focal_length_mm) + ": not in the lens table " +
                        e.lens_table_file);
-    checkGeometry(e, t, r, tn);
+    if (!e.dataset_tests) checkGeometry(e, t, r, tn); // a dataset's scene has no geometry to check
     // The whole rig of this test must be valid before anything runs.
     try {
         rigFromNode(rigForTest(e, t, 0), e.rig_file, host);
@@ -459,7 +527,7 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
 
 void readTests(Experiment &e, const YAML::Node &root, const Reader &r, const PluginHost &host) {
     const Defaults defaults = readDefaults(e, root, r, host);
-    YAML::Node tests = root["tests"];
+    const YAML::Node tests = e.dataset_tests ? datasetTests(root, r) : root["tests"];
     if (!tests || !tests.IsSequence() || tests.size() == 0) throw Error(e.file + ": missing key 'tests' (a list of tests)");
     std::set<std::string> ids;
     for (size_t i = 0; i < tests.size(); ++i) {
@@ -514,6 +582,7 @@ Experiment loadWith(const std::string &file, const PluginHost &host, const std::
     readCalibration(e, root, r);
     readLensTable(e, root, r);
     readBind(e, root, r, host);
+    e.dataset_tests = root["dataset"].IsDefined();
     readTests(e, root, r, host);
     readCharts(e, root, r);
     return e;

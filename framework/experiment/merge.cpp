@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `binocle experiment merge`: the results of shards (or partial runs) joined into one table.
-#include "experiment/charts.hpp"
+#include "experiment/dataset_tests.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/results.hpp"
 #include "experiment/test_rig.hpp"
@@ -120,11 +120,13 @@ ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::v
         }
         for (const auto &row : docs[i]["tests"]) {
             const std::string id = row["test"].get<std::string>();
+            if (e.dataset_tests && id == "mean") continue; // the shard's own means: made again below
             if (byId.count(id))
                 throw Error("experiment merge: test " + id + " is in both " + dirs[byId[id].second] + " and " + dirs[i]);
             byId[id] = {row, i};
         }
     }
+    const ExperimentTest meanTest{"mean", {}, {}, 0, {}, 0}; // dataset: the row of the means
     std::vector<Row> rows;
     TablesMeta meta = metaOf(e, 1, 1, host);
     for (const auto &t : e.tests) {
@@ -150,7 +152,7 @@ ExperimentResult mergeExperimentResults(const std::string &out_dir, const std::v
     if (ec) throw Error("experiment merge: " + out_dir + ": cannot create the folder: " + ec.message());
     prepareMergeOutput(out_dir, dirs, replace);
     copyTestFolders(out_dir, dirs, docs);
-    writeCharts(out_dir, e, rows);
+    finishRows(out_dir, e, rows, meanTest);
     writeTables(out_dir, e, rows, meta);
     return resultOf(rows);
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Running an experiment: each selected test's repeats through the rig's pipeline, a row
 // per test, the tables rewritten after every test and the charts at the end.
-#include "experiment/charts.hpp"
+#include "experiment/dataset_tests.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/results.hpp"
 #include "experiment/test_rig.hpp"
@@ -102,7 +102,8 @@ std::vector<std::pair<std::string, double>> runRepeat(const Experiment &e, const
             if (n == k) return;
         out.emplace_back(k, v);
     };
-    for (const auto &k : kMainMetrics) put(k, NAN);
+    if (!e.dataset_tests)
+        for (const auto &k : kMainMetrics) put(k, NAN);
     out.emplace_back("valid_pixel_ratio", frames ? valid / frames : NAN);
     for (size_t k = 0; k < sums.size(); ++k) {
         const double mean = counts[k] ? sums[k].second / counts[k] : NAN;
@@ -119,8 +120,10 @@ std::vector<std::pair<std::string, double>> runRepeat(const Experiment &e, const
 Row runTest(const Experiment &e, const ExperimentTest &t, const PluginHost &host, const std::string &outDir) {
     Row row;
     row.test = &t;
-    putDesign(row, e, t);
-    for (const auto &k : kMainMetrics) row.put(k, NAN);
+    if (!e.dataset_tests) { // a dataset's scene has no geometry
+        putDesign(row, e, t);
+        for (const auto &k : kMainMetrics) row.put(k, NAN);
+    }
     row.put("valid_pixel_ratio", NAN);
     const int repeats = e.repeatsOf(t);
     const bool repeating = repeats > 1 || !e.seeds.empty();
@@ -288,6 +291,7 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     meta.status = kStatusInterrupted;
 
     std::vector<Row> rows;
+    const ExperimentTest meanTest{"mean", {}, {}, 0, {}, 0}; // dataset: the row of the means
     Progress progress(options.progress, "test", static_cast<int64_t>(selected.size()));
     const auto start = std::chrono::steady_clock::now();
     for (size_t i = 0; i < selected.size(); ++i) {
@@ -311,7 +315,7 @@ ExperimentResult runExperiment(const Experiment &e, const PluginHost &host, cons
     }
     progress.update(static_cast<int64_t>(selected.size()), "done");
     progress.finish();
-    writeCharts(options.out_dir, e, rows);
+    finishRows(options.out_dir, e, rows, meanTest);
     meta.status = selected.size() == e.tests.size() ? kStatusComplete : kStatusPartial;
     writeTables(options.out_dir, e, rows, meta); // last: the status says the charts are there too
     ExperimentResult result = resultOf(rows);

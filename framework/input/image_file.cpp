@@ -9,6 +9,7 @@
 #include "input/numbers.hpp"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <jerror.h>
 #include <jpeglib.h>
@@ -369,6 +370,13 @@ cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::stri
     std::string problem;
     if (!inspectImage(data, size, info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
     if (info.format == "jpeg" && !jpegDataIsWhole(data, size, problem)) throw ImageFileError(name + ": " + problem, false);
+    if (info.format == "pfm") { // never OpenCV's PFM codec: it divides by the scale's magnitude
+        cv::Mat f = decodePfm(data, size, name, limits);
+        const bool gray = flags != cv::IMREAD_UNCHANGED && (flags & cv::IMREAD_COLOR) == 0;
+        if (gray && f.channels() == 3) cv::cvtColor(f, f, cv::COLOR_BGR2GRAY);
+        if (!gray && flags != cv::IMREAD_UNCHANGED && f.channels() == 1) cv::cvtColor(f, f, cv::COLOR_GRAY2BGR);
+        return f;
+    }
     cv::Mat m;
     try {
         m = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t *>(data)), flags);
@@ -406,7 +414,48 @@ cv::Mat decodePfm(const uint8_t *data, size_t size, const std::string &name, con
     if (!inspectImage(data, size, info, problem, limits)) throw ImageFileError(name + ": " + problem, false);
     if (info.format != "pfm")
         throw ImageFileError(name + ": not a PFM file (expected a header 'Pf' or 'PF', width, height and a non-zero scale)", false);
-    return decodeImage(data, size, cv::IMREAD_UNCHANGED, name, limits);
+    // As the format's authors and Middlebury's own tools read it: the scale's SIGN gives the
+    // byte order (negative: little-endian), its magnitude is not applied to the values
+    // (OpenCV's codec divides by it, which turns Middlebury's -1/255 files into 255 x the
+    // disparity). Rows are stored bottom to top. inspectImage checked the data's size.
+    const int rows = static_cast<int>(info.height), cols = static_cast<int>(info.width), channels = info.channels;
+    cv::Mat m(rows, cols, channels == 3 ? CV_32FC3 : CV_32FC1);
+    const bool littleEndian = info.scale < 0;
+    const size_t rowBytes = static_cast<size_t>(cols) * static_cast<size_t>(channels) * 4;
+    for (int r = 0; r < rows; ++r) {
+        const uint8_t *src = data + info.dataOffset + static_cast<size_t>(rows - 1 - r) * rowBytes;
+        auto *dst = m.ptr<float>(r);
+        for (size_t k = 0; k < rowBytes / 4; ++k) {
+            const uint8_t *b = src + 4 * k;
+            const uint32_t bits = littleEndian ? (uint32_t{b[3]} << 24 | uint32_t{b[2]} << 16 | uint32_t{b[1]} << 8 | b[0])
+                                               : be32(b);
+            float v;
+            std::memcpy(&v, &bits, 4);
+            dst[k] = v;
+        }
+    }
+    if (channels == 3) cv::cvtColor(m, m, cv::COLOR_RGB2BGR); // "PF" stores R, G, B
+    return m;
+}
+
+std::string encodePfm(const cv::Mat &image) {
+    CV_Assert(image.depth() == CV_32F && (image.channels() == 1 || image.channels() == 3));
+    cv::Mat m = image;
+    if (image.channels() == 3) cv::cvtColor(image, m, cv::COLOR_BGR2RGB);
+    // Scale -1: little-endian data, values as they are.
+    std::string out = std::string(m.channels() == 3 ? "PF" : "Pf") + "\n" + std::to_string(m.cols) + " " +
+                      std::to_string(m.rows) + "\n-1\n";
+    const size_t rowBytes = static_cast<size_t>(m.cols) * static_cast<size_t>(m.channels()) * 4;
+    out.reserve(out.size() + rowBytes * static_cast<size_t>(m.rows));
+    for (int r = m.rows - 1; r >= 0; --r) {
+        const auto *src = m.ptr<float>(r);
+        for (size_t k = 0; k < rowBytes / 4; ++k) {
+            uint32_t bits;
+            std::memcpy(&bits, &src[k], 4);
+            for (int byte = 0; byte < 4; ++byte) out += static_cast<char>((bits >> (8 * byte)) & 0xFF);
+        }
+    }
+    return out;
 }
 
 } // namespace binocle::input

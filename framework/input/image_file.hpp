@@ -68,10 +68,15 @@ cv::Mat readImage(const std::string &path, int flags, const std::string &what = 
 cv::Mat decodeImage(const uint8_t *data, size_t size, int flags, const std::string &name, const ImageLimits &limits = {});
 
 // Portable Float Map, the one PFM path of Binocle: the header is checked against the
-// limits and the data's size before anything is allocated, then OpenCV's own codec
-// decodes it. "Pf" gives CV_32FC1, "PF" CV_32FC3 in OpenCV's BGR order; top row first,
-// values as stored (inf stays inf). Anything else is refused (ImageFileError).
+// limits and the data's size before anything is allocated, then the data is read as the
+// format's authors and Middlebury's tools read it: the scale's sign gives the byte order
+// (negative = little-endian), its magnitude is NOT applied (Middlebury writes -1/255;
+// OpenCV's codec would return 255 x the disparity). "Pf" gives CV_32FC1, "PF" CV_32FC3 in
+// OpenCV's BGR order; top row first, values as stored (inf stays inf). Anything else is
+// refused (ImageFileError).
 cv::Mat readPfm(const std::string &path, const std::string &what = "PFM file", const ImageLimits &limits = {});
 cv::Mat decodePfm(const uint8_t *data, size_t size, const std::string &name, const ImageLimits &limits = {});
+// The file's bytes: scale -1 (little-endian), rows bottom to top; CV_32FC1 or CV_32FC3 (BGR).
+std::string encodePfm(const cv::Mat &image);
 
 } // namespace binocle::input

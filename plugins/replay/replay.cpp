@@ -9,6 +9,7 @@
 #include "replay_files.hpp"
 #include "replay_metadata.hpp"
 #include "replay_plan.hpp"
+#include "replay_scenes.hpp"
 
 #include "common/frame_pacer.hpp"
 #include "input/image_file.hpp"
@@ -55,7 +56,7 @@ std::vector<binocle_param_desc> parameterTable() {
         Param::path("ground_truth", "")
             .help("glob layout: pattern of disparity images (16-bit PNG d*256, 8-bit PNG d, PFM), one per pair"),
         Param::real("ground_truth_scale", "1").min(0)
-            .help("ground-truth disparities are multiplied by this after decoding (e.g. 0.5 for a half-size pair)"),
+            .help("ground-truth disparities are multiplied by this after decoding; set, it replaces a dataset's own rule"),
         Param::path("folder", "")
             .help("middlebury (a scene folder, a folder of scenes or a glob over scene folders), kitti or recording folder"),
         Param::path("bag", "").help("mcap: a rosbag2 MCAP file (.mcap) or a rosbag2 folder (metadata.yaml)"),
@@ -65,6 +66,9 @@ std::vector<binocle_param_desc> parameterTable() {
             .help("mcap: largest difference of the header stamps of a pair; images without a partner are counted"),
         Param::real("start_s", "0").min(0).unit("s").help("mcap: play from this time after the bag's first message"),
         Param::real("duration_s", "0").min(0).unit("s").help("mcap: play this long (0 = to the end)"),
+        Param::boolean("nominal_calibration", false)
+            .help("middlebury: a scene without calibration files gets a nominal rectified one (f = width px, B = 1 mm): "
+                  "disparities only, ranges meaningless"),
         Param::path("calibration", "")
             .help("OpenCV FileStorage YAML calibration that replaces the one the layout provides"),
         Param::boolean("loop", false).help("start again from the first frame after the last one"),
@@ -80,6 +84,8 @@ struct Settings {
     std::string layout = "auto";
     std::string left, right, groundTruth, folder, calibration;
     double groundTruthScale = 1.0;
+    bool groundTruthScaleGiven = false; // replaces the scale rule of a dataset's scene folders
+    bool nominalCalibration = false;
     bool loop = false;
     int64_t firstFrame = 0, maxFrames = 0;
     bool gray = false;
@@ -106,6 +112,8 @@ Settings readSettings(const sdk::Params &p) {
     path("folder", s.folder);
     path("calibration", s.calibration);
     s.groundTruthScale = c.real("ground_truth_scale");
+    s.groundTruthScaleGiven = c.isExplicit("ground_truth_scale");
+    s.nominalCalibration = c.boolean("nominal_calibration");
     s.loop = c.boolean("loop");
     s.firstFrame = c.integer("first_frame");
     s.maxFrames = c.integer("max_frames");
@@ -165,15 +173,17 @@ Plan planGlob(const Settings &s) {
         f.left = lefts[i];
         f.right = rights[i];
         if (!truths.empty()) f.groundTruth = truths[i];
+        f.groundTruthScale = s.groundTruthScale;
         plan.frames.push_back(std::move(f));
     }
     return plan;
 }
 
 // ---- middlebury layout -------------------------------------------------------------------
-// A scene folder: im0.png (left), im1.png (right), calib.txt, disp0.pfm or disp0GT.pfm.
+// Scene folders of the public datasets (replay_scenes.hpp): Middlebury 2001-2014,
+// MiddEval3, a KITTI pair in a folder of its own; one scene or a folder of them.
 
-bool isMiddleburyScene(const fs::path &folder) { return fs::is_regular_file(folder / "im0.png"); }
+bool isMiddleburyScene(const fs::path &folder) { return isSceneFolder(folder); }
 
 // calib.txt: see replay_metadata.hpp.
 PinholePair readMiddleburyCalib(const fs::path &file, const fs::path &leftImage,
@@ -188,54 +198,33 @@ PinholePair readMiddleburyCalib(const fs::path &file, const fs::path &leftImage,
     return pair;
 }
 
-std::vector<fs::path> middleburyScenes(const std::string &folder) {
-    std::vector<fs::path> scenes;
-    if (hasWildcard(folder)) {
-        for (fs::path &p : globPaths(folder))
-            if (fs::is_directory(p)) scenes.push_back(std::move(p));
-        if (scenes.empty())
-            throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder pattern '" + folder + "' matched no folder");
-        for (const fs::path &p : scenes)
-            if (!isMiddleburyScene(p))
-                throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder pattern '" + folder + "' matched " + inQuotes(p) +
-                                                       ", which holds no im0.png; expected Middlebury scene folders");
-        return scenes;
-    }
-    if (!fs::is_directory(folder))
-        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder '" + folder + "' does not exist or is not a folder");
-    if (isMiddleburyScene(folder)) return {fs::path(folder)};
-    for (fs::path &p : listFolder(folder, true))
-        if (isMiddleburyScene(p)) scenes.push_back(std::move(p));
-    if (scenes.empty())
-        throw Error(BINOCLE_ERR_NOT_FOUND, "replay: folder '" + folder +
-                                               "' holds no im0.png, nor any sub-folder that does; expected a Middlebury scene");
-    return scenes;
-}
-
 Plan planMiddlebury(const Settings &s, const sdk::Host &host) {
     Plan plan;
     plan.layout = "middlebury";
     std::vector<std::pair<fs::path, PinholePair>> calibrations;
-    for (const fs::path &scene : middleburyScenes(s.folder)) {
-        FrameFiles f;
-        f.left = scene / "im0.png";
-        f.right = scene / "im1.png";
-        if (!fs::is_regular_file(f.right))
-            throw Error(BINOCLE_ERR_NOT_FOUND, "replay: Middlebury scene " + inQuotes(scene) + " has im0.png but no im1.png");
-        for (const char *name : {"disp0.pfm", "disp0GT.pfm"})
-            if (f.groundTruth.empty() && fs::is_regular_file(scene / name)) f.groundTruth = scene / name;
-        f.facts.emplace_back("scene", scene.filename().string());
+    for (const fs::path &scene : sceneFolders(s.folder)) {
+        FrameFiles f = sceneFrame(scene, s.groundTruthScaleGiven ? s.groundTruthScale : 0.0);
         const fs::path calib = scene / "calib.txt";
         if (fs::is_regular_file(calib)) {
             PinholePair pair = readMiddleburyCalib(calib, f.left, f.facts);
             pair.addFacts(f, calib);
             calibrations.emplace_back(calib, pair);
-        } else if (s.calibration.empty()) {
-            host.warning("replay: Middlebury scene " + inQuotes(scene) + " has no calib.txt; it brings no calibration");
+        } else if (s.calibration.empty() && !s.nominalCalibration) {
+            host.warning("replay: scene " + inQuotes(scene) + " has no calib.txt; it brings no calibration");
         }
         plan.frames.push_back(std::move(f));
     }
     plan.calibration = publishFirst(calibrations, host);
+    if (plan.calibration.empty() && s.nominalCalibration) { // disparities only: see nominal_calibration
+        PinholePair nominal;
+        nominal.imageSize = imageSizeOf(plan.frames.front().left);
+        const double w = nominal.imageSize.width, h = nominal.imageSize.height;
+        nominal.M1 = nominal.M2 = cv::Matx33d(w, 0, (w - 1) / 2, 0, w, (h - 1) / 2, 0, 0, 1);
+        nominal.baselineMm = 1;
+        plan.calibration = nominal.toYaml();
+        host.info("replay: no calibration in the scene; a nominal one (f = " + std::to_string(static_cast<int>(w)) +
+                  " px, B = 1 mm) is published: disparities are scored, ranges mean nothing");
+    }
     return plan;
 }
 
@@ -307,6 +296,11 @@ Plan planKitti(const Settings &s, const sdk::Host &host) {
             throw Error(BINOCLE_ERR_NOT_FOUND, "replay: KITTI left image " + inQuotes(left) + " has no right image " +
                                                    inQuotes(f.right));
         if (!truthDir.empty() && fs::is_regular_file(truthDir / left.filename())) f.groundTruth = truthDir / left.filename();
+        f.groundTruthScale = s.groundTruthScale;
+        if (!f.groundTruth.empty()) // the noc ground truth's known pixels are the non-occluded ones
+            for (const char *dir : {"disp_noc_0", "disp_noc"})
+                if (f.nonoccTruth.empty() && fs::is_regular_file(folder / dir / left.filename()))
+                    f.nonoccTruth = folder / dir / left.filename();
         plan.frames.push_back(std::move(f));
     }
     if (plan.frames.empty())
@@ -438,8 +432,9 @@ std::string detectLayout(const Settings &s) {
         if (isMiddleburyScene(sub)) return "middlebury";
     throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                 "replay: folder " + inQuotes(folder) +
-                    " holds none of the known layouts: frames.csv (recording), im0.png and im1.png (middlebury, also "
-                    "in sub-folders), image_2/ and image_3/ (kitti), metadata.yaml or *.mcap (mcap); set `layout` "
+                    " holds none of the known layouts: frames.csv (recording), a stereo pair im0/im1, view1/view5, "
+                    "imL/imR, im2/im6 or left/right (middlebury scene, also in sub-folders), image_2/ and image_3/ "
+                    "(kitti), metadata.yaml or *.mcap (mcap); set `layout` "
                     "or use `left`/`right` patterns");
 }
 
@@ -501,7 +496,7 @@ Plan makePlan(const Settings &s, const sdk::Host &host) {
 
 // Pixels of one lent frame; lives until the host releases it.
 struct Pixels {
-    cv::Mat left, right, gtDisparity, gtValid;
+    cv::Mat left, right, gtDisparity, gtValid, gtNonocc, gtDisc;
 };
 
 binocle_image lend(const cv::Mat &m, int32_t format) {
@@ -617,13 +612,11 @@ private:
                                                           sizeText(px.left) + " but right image " + inQuotes(files.right) +
                                                           " is " + sizeText(px.right) + "; a pair must have one size");
         if (!files.groundTruth.empty()) {
-            GroundTruth gt = readGroundTruth(files.groundTruth, settings_.groundTruthScale);
-            if (gt.disparity.size() != px.left.size())
-                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + inQuotes(files.groundTruth) + " is " +
-                                                              sizeText(gt.disparity) + " but left image " +
-                                                              inQuotes(files.left) + " is " + sizeText(px.left));
+            FrameTruth gt = readFrameTruth(files, px.left.size());
             px.gtDisparity = gt.disparity;
             px.gtValid = gt.valid;
+            px.gtNonocc = gt.nonocc;
+            px.gtDisc = gt.disc;
         }
         return true;
     }
@@ -643,6 +636,8 @@ private:
         if (!px->gtDisparity.empty()) {
             frame->extras.emplace_back("gt_disparity", lend(px->gtDisparity, BINOCLE_PIXEL_FLOAT32));
             frame->extras.emplace_back("gt_valid", lend(px->gtValid, BINOCLE_PIXEL_GRAY8));
+            if (!px->gtNonocc.empty()) frame->extras.emplace_back("gt_nonocc", lend(px->gtNonocc, BINOCLE_PIXEL_GRAY8));
+            if (!px->gtDisc.empty()) frame->extras.emplace_back("gt_disc", lend(px->gtDisc, BINOCLE_PIXEL_GRAY8));
         }
         frame->metadata = metadata(files);
         frame->owner = std::move(px);

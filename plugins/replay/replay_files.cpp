@@ -172,7 +172,23 @@ cv::Mat readPfm(const fs::path &path) {
     }
 }
 
-GroundTruth readGroundTruth(const fs::path &path, double scale) {
+namespace {
+// A palette PNG with a grey palette (Tsukuba's groundtruth.png) decodes to three equal
+// channels: one of them is the image. Another three-channel image is refused.
+cv::Mat oneChannel(const cv::Mat &raw, const std::string &name) {
+    if (raw.channels() == 1) return raw;
+    if (raw.channels() == 3 && raw.depth() == CV_8U) {
+        std::vector<cv::Mat> c;
+        cv::split(raw, c);
+        if (cv::countNonZero(c[0] != c[1]) == 0 && cv::countNonZero(c[0] != c[2]) == 0) return c[0];
+    }
+    throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + name + " has " + std::to_string(raw.channels()) +
+                                                  " channels that differ; expected a one-channel disparity image (or a "
+                                                  "grey palette)");
+}
+} // namespace
+
+GroundTruth readGroundTruth(const fs::path &path, double scale, int imageWidth) {
     const std::string name = "'" + path.string() + "'";
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -187,9 +203,7 @@ GroundTruth readGroundTruth(const fs::path &path, double scale) {
                         std::string("replay: ") + e.what() + " (expected a 16-bit PNG (d*256), 8-bit PNG or PFM)");
         }
     }
-    if (raw.channels() != 1)
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: ground truth " + name + " has " + std::to_string(raw.channels()) +
-                                                      " channels; expected a one-channel disparity image");
+    raw = oneChannel(raw, name);
     GroundTruth gt;
     switch (raw.depth()) {
     case CV_16U:
@@ -201,9 +215,19 @@ GroundTruth readGroundTruth(const fs::path &path, double scale) {
         cv::compare(raw, 0, gt.valid, cv::CMP_GT);
         break;
     case CV_32F: {
-        cv::Mat positive, finite;
+        cv::Mat positive, finite, negative;
         cv::compare(raw, 0.0, positive, cv::CMP_GT); // NaN compares false
         cv::compare(raw, std::numeric_limits<double>::max(), finite, cv::CMP_LT);
+        cv::compare(raw, -std::numeric_limits<double>::max(), negative, cv::CMP_GE);
+        negative &= ~positive & (raw != 0);
+        if (const int n = cv::countNonZero(negative)) {
+            cv::Point where;
+            cv::minMaxLoc(negative, nullptr, nullptr, nullptr, &where);
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                        "replay: ground truth " + name + " holds " + std::to_string(n) + " negative disparities (first " +
+                            std::to_string(raw.at<float>(where)) + " at (" + std::to_string(where.x) + ", " +
+                            std::to_string(where.y) + ")); expected disparities >= 0, unknown marked inf, NaN or 0");
+        }
         gt.valid = positive & finite;
         raw.convertTo(gt.disparity, CV_32F, scale);
         break;
@@ -213,6 +237,17 @@ GroundTruth readGroundTruth(const fs::path &path, double scale) {
                     "replay: ground truth " + name + " has an unsupported pixel depth; expected 8-bit, 16-bit or float");
     }
     gt.disparity.setTo(-1.0f, ~gt.valid);
+    if (imageWidth > 0) {
+        double most = 0;
+        cv::Point where;
+        cv::minMaxLoc(gt.disparity, nullptr, &most, nullptr, &where, gt.valid);
+        if (most >= imageWidth)
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
+                        "replay: ground truth " + name + " holds disparity " + std::to_string(most) + " px at (" +
+                            std::to_string(where.x) + ", " + std::to_string(where.y) + "), not less than the image width " +
+                            std::to_string(imageWidth) + " px: not a disparity of this image (wrong ground_truth_scale, or "
+                            "a PFM read by its scale's magnitude?)");
+    }
     return gt;
 }
 

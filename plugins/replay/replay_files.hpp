@@ -28,21 +28,24 @@ std::vector<std::filesystem::path> globPaths(const std::string &pattern);
 // The entries of a folder, in natural order; regular files or folders only.
 std::vector<std::filesystem::path> listFolder(const std::filesystem::path &folder, bool folders);
 
-// Portable Float Map through Binocle's one PFM path (input::readPfm: header checked,
-// then OpenCV's codec): CV_32FC1 or CV_32FC3, top row first, values as stored (inf stays
-// inf). Throws sdk::Error naming the file.
+// Portable Float Map through Binocle's one PFM path (input::readPfm: header checked, the
+// scale's sign is the byte order, its magnitude is not applied): CV_32FC1 or CV_32FC3, top
+// row first, values as stored (inf stays inf). Throws sdk::Error naming the file.
 cv::Mat readPfm(const std::filesystem::path &path);
 
 // A disparity ground truth, decoded by format:
 //   16-bit PNG  value / 256 (KITTI), 0 = unknown
 //   8-bit image value, 0 = unknown
-//   PFM / float value, inf, NaN and <= 0 = unknown
-// then multiplied by `scale`. disparity: CV_32F, -1 where unknown; valid: CV_8U 0/255.
+//   PFM / float value, inf, NaN and 0 = unknown; a negative value is refused
+// then multiplied by `scale`. A grey palette PNG is read as its grey values.
+// disparity: CV_32F, -1 where unknown; valid: CV_8U 0/255. With `imageWidth` > 0, a known
+// disparity >= imageWidth is refused (it cannot be a disparity of the image). Throws
+// sdk::Error naming the file.
 struct GroundTruth {
     cv::Mat disparity;
     cv::Mat valid;
 };
-GroundTruth readGroundTruth(const std::filesystem::path &path, double scale);
+GroundTruth readGroundTruth(const std::filesystem::path &path, double scale, int imageWidth = 0);
 
 // The text of a small metadata file (at most 16 MiB); a folder, a missing or a larger file is
 // refused (sdk::Error naming `what` and the path).

@@ -24,6 +24,14 @@ namespace binocle::replay {
 struct FrameFiles {
     std::filesystem::path left, right;
     std::filesystem::path groundTruth; // empty: no ground truth for this pair
+    // Decoded ground-truth values are multiplied by this (16-bit PNGs are first divided by
+    // 256): the dataset's rule (replay_scenes.hpp), or `ground_truth_scale` when given.
+    double groundTruthScale = 1.0;
+    // Masks of the dataset, empty when it has none (replay_scenes.hpp): non-occluded pixels
+    // (Middlebury nonocc.png / mask0nocc.png, == 255), the pixels of the "all" score
+    // (Middlebury v2 all.png), near discontinuities (disc.png); KITTI: the noc ground truth,
+    // whose known pixels are the non-occluded ones.
+    std::filesystem::path nonoccMask, allMask, discMask, nonoccTruth;
     bool hasTimestamps = false;
     int64_t timestampLeftNs = 0, timestampRightNs = 0;
     // Layout-specific facts for the frame's metadata ("ndisp", "recorded_sequence" ...).

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Fuzz harness: Binocle's one PFM path (input::decodePfm: the header is checked against
-// the image limits and the data's size, then OpenCV's codec decodes), used by the replay
+// the image limits and the data's size, then the data read by the scale's sign), used by the replay
 // source's ground truths and by `binocle` itself.
 #include "input/image_file.hpp"
 

@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <fstream>
 #include <sstream>
@@ -263,6 +265,42 @@ TEST(Yaml, OneKeyCheckerNamesTheKeyTheNearestAndTheValidOnes) {
     EXPECT_THROW(checkKeys(parseYaml("[1, 2]", "x"), {"a"}, "list", "x"), YamlError);
     EXPECT_EQ(nearestWord("num_disparity", {"min_disparity", "num_disparities"}), "num_disparities");
     EXPECT_EQ(nearestWord("zzz", {"num_disparities", "block_size"}), "");
+}
+
+// Middlebury's PFM files carry the scale -1/255: only its sign counts (little-endian); the
+// values are the disparities as stored (OpenCV's codec would give 255 x them).
+TEST(ImageFile, PfmScaleGivesTheByteOrderOnlyNeverItsMagnitude) {
+    std::string le = "Pf\n2 1\n-0.003922\n";
+    for (float v : {12.5f, std::numeric_limits<float>::infinity()}) {
+        unsigned char b[4];
+        std::memcpy(b, &v, 4); // the host is little-endian (x86-64, arm64)
+        le.append(reinterpret_cast<const char *>(b), 4);
+    }
+    const cv::Mat m = decodePfm(reinterpret_cast<const uint8_t *>(le.data()), le.size(), "mb.pfm");
+    EXPECT_EQ(m.at<float>(0, 0), 12.5f);
+    EXPECT_TRUE(std::isinf(m.at<float>(0, 1)));
+    // Big-endian with a scale of magnitude 255: values unchanged too.
+    const unsigned char be[] = {'P', 'f', '\n', '1', ' ', '1', '\n', '2', '5', '5', '\n', 0x41, 0x48, 0, 0};
+    EXPECT_EQ(decodePfm(be, sizeof be, "be.pfm").at<float>(0, 0), 12.5f);
+    // readImage of a PFM takes the same path.
+    const auto path = std::filesystem::temp_directory_path() / "binocle_input_test_scale.pfm";
+    { std::ofstream(path, std::ios::binary) << le; }
+    EXPECT_EQ(readImage(path.string(), cv::IMREAD_UNCHANGED).at<float>(0, 0), 12.5f);
+    std::filesystem::remove(path);
+    // The one writer: scale -1, rows bottom to top, read back exactly (grey and colour).
+    cv::Mat g = (cv::Mat_<float>(2, 3) << 1, 2, 3, 4, 5, std::numeric_limits<float>::infinity());
+    const std::string bytes = encodePfm(g);
+    EXPECT_EQ(bytes.substr(0, 10), "Pf\n3 2\n-1\n");
+    float first = 0;
+    std::memcpy(&first, bytes.data() + 10, 4);
+    EXPECT_EQ(first, 4.0f); // the bottom row first
+    const cv::Mat gb = decodePfm(reinterpret_cast<const uint8_t *>(bytes.data()), bytes.size(), "g.pfm");
+    EXPECT_EQ(cv::countNonZero(gb != g), 0);
+    cv::Mat c(2, 2, CV_32FC3, cv::Scalar(1, 2, 3));
+    const std::string cbytes = encodePfm(c);
+    const cv::Mat cb = decodePfm(reinterpret_cast<const uint8_t *>(cbytes.data()), cbytes.size(), "c.pfm");
+    ASSERT_EQ(cb.type(), CV_32FC3);
+    EXPECT_EQ(cb.at<cv::Vec3f>(1, 1), cv::Vec3f(1, 2, 3));
 }
 
 TEST(ImageFile, OnePfmPathRoundTripsThroughOpenCvsCodec) {

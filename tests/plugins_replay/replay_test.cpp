@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Tests of the replay source plugin, loaded through the plugin host, on data each test writes.
+#include "replay_fixture.hpp"
+
 #include "config/rig_config.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
@@ -21,96 +23,8 @@
 #include <unistd.h>
 #include <vector>
 
-namespace fs = std::filesystem;
-using binocle::LentFrame;
-using binocle::Source;
 
 namespace {
-
-const binocle::PluginRecord &replayRecord() {
-    static binocle::PluginHost host(std::vector<std::string>{BINOCLE_BUILD_PLUGIN_DIR});
-    static const binocle::PluginRecord &record = [] () -> const binocle::PluginRecord & {
-        host.scan();
-        return host.require("replay", BINOCLE_KIND_STEREO_SOURCE);
-    }();
-    return record;
-}
-
-// A fresh folder per test, removed afterwards.
-class Replay : public ::testing::Test {
-protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("binocle_replay_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        if (!HasFailure()) fs::remove_all(dir_, ec);
-    }
-
-    fs::path path(const std::string &relative) const { return dir_ / relative; }
-
-    std::unique_ptr<Source> open(const std::string &yaml) {
-        auto src = std::make_unique<Source>(replayRecord(), binocle::paramsFromYaml(replayRecord(), yaml));
-        src->start();
-        return src;
-    }
-
-    // The message of the error that opening with `yaml` must raise.
-    std::string openError(const std::string &yaml) {
-        try {
-            open(yaml);
-        } catch (const binocle::Error &e) {
-            return e.what();
-        }
-        ADD_FAILURE() << "opening succeeded: " << yaml;
-        return {};
-    }
-
-    fs::path dir_;
-};
-
-// Random pixels, different for every seed.
-cv::Mat noise(cv::Size size, int type, int seed) {
-    cv::Mat m(size, type);
-    cv::RNG rng(static_cast<uint64_t>(seed) + 1);
-    rng.fill(m, cv::RNG::UNIFORM, 0, 256);
-    return m;
-}
-
-void write(const fs::path &p, const cv::Mat &m) {
-    fs::create_directories(p.parent_path());
-    ASSERT_TRUE(cv::imwrite(p.string(), m)) << p;
-}
-
-void writeText(const fs::path &p, const std::string &text) {
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-}
-
-bool equal(const cv::Mat &a, const cv::Mat &b) {
-    return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
-}
-
-// PFM written by hand, big-endian (positive scale), rows bottom to top.
-void writePfmBigEndian(const fs::path &p, const cv::Mat &m) {
-    ASSERT_EQ(m.type(), CV_32FC1);
-    std::ofstream out(p, std::ios::binary);
-    out << "Pf\n" << m.cols << " " << m.rows << "\n1.0\n";
-    for (int v = m.rows - 1; v >= 0; --v)
-        for (int u = 0; u < m.cols; ++u) {
-            unsigned char b[4];
-            std::memcpy(b, &m.at<float>(v, u), 4);
-            const char be[4] = {static_cast<char>(b[3]), static_cast<char>(b[2]), static_cast<char>(b[1]),
-                                static_cast<char>(b[0])};
-            out.write(be, 4);
-        }
-}
-
-YAML::Node metadataOf(const LentFrame &f) { return YAML::Load(f.metadata()); }
 
 cv::FileStorage readCalibration(const std::string &text) {
     return cv::FileStorage(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
@@ -190,7 +104,7 @@ TEST_F(Replay, ColorGrayDeliversGray8) {
 }
 
 TEST_F(Replay, GlobGroundTruthIn16BitPng) {
-    const cv::Size size(10, 8);
+    const cv::Size size(16, 8); // disparities must be less than the width
     write(path("l0.png"), noise(size, CV_8UC3, 0));
     write(path("r0.png"), noise(size, CV_8UC3, 1));
     cv::Mat raw(size, CV_16UC1, cv::Scalar(0));
@@ -214,7 +128,7 @@ TEST_F(Replay, GlobGroundTruthIn16BitPng) {
 }
 
 TEST_F(Replay, GlobGroundTruthIn8BitPngIsScaled) {
-    const cv::Size size(10, 8);
+    const cv::Size size(24, 8);
     write(path("l0.png"), noise(size, CV_8UC1, 0));
     write(path("r0.png"), noise(size, CV_8UC1, 1));
     cv::Mat raw(size, CV_8UC1, cv::Scalar(40));
@@ -231,7 +145,7 @@ TEST_F(Replay, GlobGroundTruthIn8BitPngIsScaled) {
 }
 
 TEST_F(Replay, GlobGroundTruthInPfm) {
-    const cv::Size size(7, 5);
+    const cv::Size size(12, 5);
     write(path("l0.png"), noise(size, CV_8UC3, 0));
     write(path("r0.png"), noise(size, CV_8UC3, 1));
     cv::Mat d(size, CV_32FC1);
@@ -354,7 +268,7 @@ void writeMiddleburyScene(const fs::path &scene, int seed, double baselineMm = 1
 TEST_F(Replay, MiddleburySceneWithCalibrationAndPfmGroundTruth) {
     const fs::path scene = path("Aloe");
     writeMiddleburyScene(scene, 7);
-    cv::Mat d(8, 12, CV_32FC1, cv::Scalar(12.75f));
+    cv::Mat d(8, 12, CV_32FC1, cv::Scalar(10.75f));
     d.at<float>(1, 2) = std::numeric_limits<float>::infinity();
     d.at<float>(7, 0) = 3.0f;
     writePfmBigEndian(scene / "disp0.pfm", d);
@@ -365,7 +279,7 @@ TEST_F(Replay, MiddleburySceneWithCalibrationAndPfmGroundTruth) {
     EXPECT_TRUE(equal(f->left(), noise({12, 8}, CV_8UC3, 7)));
     EXPECT_TRUE(equal(f->right(), noise({12, 8}, CV_8UC3, 8)));
     cv::Mat gt = f->extra("gt_disparity");
-    EXPECT_FLOAT_EQ(gt.at<float>(0, 0), 12.75f);
+    EXPECT_FLOAT_EQ(gt.at<float>(0, 0), 10.75f);
     EXPECT_FLOAT_EQ(gt.at<float>(7, 0), 3.0f);
     EXPECT_LE(gt.at<float>(1, 2), 0.0f);
     EXPECT_EQ(f->extra("gt_valid").at<uint8_t>(1, 2), 0);
@@ -398,7 +312,7 @@ TEST_F(Replay, MiddleburyPfmFromTheFrameworkWriter) {
     const fs::path scene = path("scene");
     writeMiddleburyScene(scene, 1);
     cv::Mat d(8, 12, CV_32FC1);
-    cv::randu(d, 1.0, 60.0);
+    cv::randu(d, 1.0, 11.0); // disparities of a 12-pixel-wide image
     d.at<float>(3, 3) = std::numeric_limits<float>::infinity();
     binocle::writePfm((scene / "disp0GT.pfm").string(), d); // little-endian, MiddEval3 name
     auto src = open("{layout: middlebury, folder: " + scene.string() + "}");
@@ -458,7 +372,7 @@ TEST_F(Replay, KittiTreeWithGroundTruthAndCalibration) {
         write(kitti / "image_3" / name, noise(size, CV_8UC3, seed + 50));
     }
     cv::Mat raw(size, CV_16UC1, cv::Scalar(0));
-    raw.at<uint16_t>(5, 5) = 33 * 256 + 64;
+    raw.at<uint16_t>(5, 5) = 13 * 256 + 64;
     write(kitti / "disp_occ_0" / "000000_10.png", raw);
     write(kitti / "disp_noc_0" / "000000_10.png", cv::Mat(size, CV_16UC1, cv::Scalar(0)));
     // KITTI 2015 style: f = 721.5377, cam2 t_x = +0.0598 m, cam3 t_x = -0.4728 m.
@@ -479,9 +393,10 @@ TEST_F(Replay, KittiTreeWithGroundTruthAndCalibration) {
         EXPECT_TRUE(equal(f->left(), noise(size, CV_8UC3, seed))) << file;
         EXPECT_TRUE(equal(f->right(), noise(size, CV_8UC3, seed + 50))) << file;
         if (file == "000000_10.png") {
-            ASSERT_EQ(f->raw().extra_count, 2);
-            EXPECT_FLOAT_EQ(f->extra("gt_disparity").at<float>(5, 5), 33.25f); // disp_occ_0 preferred
+            ASSERT_EQ(f->raw().extra_count, 3);
+            EXPECT_FLOAT_EQ(f->extra("gt_disparity").at<float>(5, 5), 13.25f); // disp_occ_0 preferred
             EXPECT_EQ(cv::countNonZero(f->extra("gt_valid")), 1);
+            EXPECT_EQ(cv::countNonZero(f->extra("gt_nonocc")), 0); // disp_noc_0 knows no pixel
         } else {
             EXPECT_EQ(f->raw().extra_count, 0) << file;
         }

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 # py_bad_pixels: a test fixture, an evaluator written in Python: the `disparity`
-# evaluator's bad-pixel rate and density in numpy, so that a test compares the arrays
+# evaluator's bad-pixel rate over all pixels (holes counted as errors) and density in numpy, so that a test compares the arrays
 # the bridge hands over with what the C evaluator reads; it also reports what it saw
 # (shapes, the cloud, the disparity range) as figures a test can check.
 import numpy as np
@@ -31,8 +31,9 @@ class BadPixels:
         if "gt_valid" in frame.extras:
             known &= frame.extras["gt_valid"] != 0
         matched = known & (frame.disparity > 0) & np.isfinite(frame.disparity)
-        bad = matched & (np.abs(frame.disparity - truth) > self.threshold)
-        figures["bad_percent"] = (100.0 * bad.sum() / max(matched.sum(), 1), "%")
+        # Holes count as errors, as the C evaluator's bad_<t>px_all_percent counts them.
+        bad = (matched & (np.abs(frame.disparity - truth) > self.threshold)) | (known & ~matched)
+        figures["bad_percent"] = (100.0 * bad.sum() / max(known.sum(), 1), "%")
         figures["density_percent"] = (100.0 * matched.sum() / max(known.sum(), 1), "%")
         return figures
 

@@ -22,7 +22,7 @@ def test_python_evaluator_sees_what_the_c_evaluator_sees(tmp_path, isolation):
     with open(os.path.join(out, "frames.jsonl")) as f:
         frame = json.loads(f.readline())
     c, py = frame["metrics"]["disparity"], frame["metrics"]["py_bad_pixels"]
-    assert py["bad_percent"] == pytest.approx(c["bad_2px_percent"], abs=1e-9), (c, py)
+    assert py["bad_percent"] == pytest.approx(c["bad_2px_all_percent"], abs=1e-9), (c, py)
     assert py["density_percent"] == pytest.approx(c["density_percent"], abs=1e-9), (c, py)
     assert (py["left_height_px"], py["left_width_px"]) == (1110, 1282)
     assert py["cloud_points"] == frame["points"]

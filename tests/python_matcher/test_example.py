@@ -32,8 +32,11 @@ def test_run_on_aloe_gives_a_plausible_disparity(tmp_path):
     f = figures(out)
     # Loaded machine, 2 cores: about 20 s for the 1282 x 1110 pair and 256 disparities.
     # sgbm (block 5) scores bad-2 about 10 % here; a plain SAD with a uniqueness check
-    # must stay below 20 % of the pixels it matched, and match most of them.
-    assert f["bad_2px_percent"] < 20, f
+    # must stay below 20 % of the pixels it matched, and match most of them. The evaluator
+    # counts holes as errors (bad_2px_all_percent); the matched pixels' own rate is
+    # (bad - invalid) / density.
+    matched_bad = 100 * (f["bad_2px_all_percent"] - f["invalid_all_percent"]) / f["density_percent"]
+    assert matched_bad < 20, f
     assert f["density_percent"] > 50, f
     assert os.path.exists(os.path.join(out, "disparity_000000.png"))
 
