@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
-// sgm: the dense option (sgm_fill.hpp). Two passes over the image: the pass down gathers,
-// for each invalid pixel, the nearest valid disparity on its left and along the three
-// directions from above; the pass up those on its right and from below, then fills the
-// row. The vertical and diagonal directions are carried from row to row (a row of values
-// each), so each pass reads every pixel once.
+// sgm: the dense option (sgm_fill.hpp). The invalid pixels are listed; two passes over
+// the image (in parallel) gather, for each of them, the nearest valid disparity along 8
+// directions: the pass down on its left and from above, the pass up on its right and
+// from below; then the rows are filled (in parallel). The vertical and diagonal directions
+// are carried from row to row (a row of values each), so each pass reads every pixel once.
 #include "sgm_fill.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <opencv2/core/hal/intrin.hpp>
 
 namespace sgm {
 
@@ -18,22 +20,47 @@ constexpr int kCarryDx[3] = {0, -1, 1};
 
 // A row's carried values: cur[x] = the pixel's own when valid, else what the direction
 // brings from the previous row (prev[x + dx]); both rows have a spare column at each end.
+// (OpenCV's universal intrinsics: a vector of floats at a time where the build has them.)
 void carryRow(const float *row, int width, float invalid, const std::vector<float> (&prev)[3],
               std::vector<float> (&cur)[3]) {
     for (int d = 0; d < 3; ++d) {
         const float *p = prev[d].data() + 1 + kCarryDx[d];
         float *c = cur[d].data() + 1;
-        for (int x = 0; x < width; ++x) c[x] = row[x] != invalid ? row[x] : p[x];
+        int x = 0;
+#if CV_SIMD
+        const cv::v_float32 none = cv::vx_setall_f32(invalid);
+        for (; x + cv::v_float32::nlanes <= width; x += cv::v_float32::nlanes) {
+            const cv::v_float32 v = cv::vx_load(row + x);
+            cv::v_store(c + x, cv::v_select(v != none, v, cv::vx_load(p + x)));
+        }
+#endif
+        for (; x < width; ++x) c[x] = row[x] != invalid ? row[x] : p[x];
     }
 }
 
-// Sorts the n (<= 8) values in place (insertion sort: a handful of values).
-void sortSmall(float *v, int n) {
-    for (int i = 1; i < n; ++i) {
-        const float key = v[i];
-        int j = i - 1;
-        for (; j >= 0 && v[j] > key; --j) v[j + 1] = v[j];
-        v[j + 1] = key;
+// Appends the columns of the row's invalid pixels to `out`, in order (a vector of pixels
+// compared at a time where the build has SIMD: most are valid).
+void invalidColumns(const float *row, int width, float invalid, std::vector<int32_t> &out) {
+    int x = 0;
+#if CV_SIMD
+    const cv::v_float32 none = cv::vx_setall_f32(invalid);
+    for (; x + cv::v_float32::nlanes <= width; x += cv::v_float32::nlanes)
+        for (int bits = cv::v_signmask(cv::vx_load(row + x) == none); bits; bits &= bits - 1)
+            out.push_back(x + __builtin_ctz(static_cast<unsigned>(bits)));
+#endif
+    for (; x < width; ++x)
+        if (row[x] == invalid) out.push_back(x);
+}
+
+// Sorts 8 values in place: a sorting network of 19 comparators (Knuth, TAOCP 5.3.4),
+// branchless; absent values are +inf and end last.
+void sort8(float *v) {
+    static constexpr int kPairs[19][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {1, 2}, {5, 6},
+                                          {0, 4}, {3, 7}, {1, 5}, {2, 6}, {1, 4}, {3, 6}, {2, 4}, {3, 5}, {3, 4}};
+    for (const auto &p : kPairs) {
+        const float a = v[p[0]], b = v[p[1]];
+        v[p[0]] = std::min(a, b);
+        v[p[1]] = std::max(a, b);
     }
 }
 
@@ -45,70 +72,63 @@ void Filler::fill(cv::Mat &disparity, float invalid, float occlusionJumpPx, cv::
     filled.setTo(cv::Scalar(0));
     if (disparity.empty()) return;
     width_ = disparity.cols;
-    for (auto &rows : carry_)
-        for (auto &row : rows) row.assign(static_cast<size_t>(width_) + 2, invalid);
-    passDown(disparity, invalid);
-    for (auto &rows : carry_)
-        for (auto &row : rows) std::fill(row.begin(), row.end(), invalid);
-    passUp(disparity, invalid, occlusionJumpPx, filled);
-}
-
-void Filler::passDown(const cv::Mat &disparity, float invalid) {
     const int height = disparity.rows;
+    // The invalid pixels, row by row.
     rowStart_.assign(static_cast<size_t>(height) + 1, 0);
     column_.clear();
-    values_.clear();
-    int parity = 0;
     for (int y = 0; y < height; ++y) {
-        const float *row = disparity.ptr<float>(y);
-        carryRow(row, width_, invalid, carry_[parity ^ 1], carry_[parity]);
-        const std::vector<float>(&cur)[3] = carry_[parity];
         rowStart_[static_cast<size_t>(y)] = static_cast<int32_t>(column_.size());
-        float left = invalid;
-        for (int x = 0; x < width_; ++x) {
-            if (row[x] != invalid) {
-                left = row[x];
-                continue;
-            }
-            column_.push_back(x);
-            const size_t at = static_cast<size_t>(x) + 1;
-            values_.insert(values_.end(), {left, cur[0][at], cur[1][at], cur[2][at], invalid, invalid, invalid, invalid});
-        }
-        parity ^= 1;
+        invalidColumns(disparity.ptr<float>(y), width_, invalid, column_);
     }
     rowStart_[static_cast<size_t>(height)] = static_cast<int32_t>(column_.size());
+    values_.resize(column_.size() * kDirections);
+    // The two passes read the disparity only and write distinct values: in parallel;
+    // then the rows are filled, in parallel too.
+    cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range &r) {
+        for (int pass = r.start; pass < r.end; ++pass) gather(disparity, invalid, pass == 0);
+    });
+    cv::parallel_for_(cv::Range(0, height), [&](const cv::Range &r) {
+        for (int y = r.start; y < r.end; ++y)
+            fillRow(disparity.ptr<float>(y), filled.ptr<uint8_t>(y), y, invalid, occlusionJumpPx);
+    });
 }
 
-void Filler::passUp(cv::Mat &disparity, float invalid, float occlusionJumpPx, cv::Mat &filled) {
+// Down: the left direction and the three from above (values 0 .. 3 of each invalid
+// pixel); up: the right direction and the three from below (4 .. 7).
+void Filler::gather(const cv::Mat &disparity, float invalid, bool down) {
+    const int height = disparity.rows, step = down ? 1 : -1, side = down ? -1 : 1, slot = down ? 0 : 4;
+    std::vector<float>(&carry)[2][3] = carry_[down ? 0 : 1];
+    for (auto &rows : carry)
+        for (auto &row : rows) row.assign(static_cast<size_t>(width_) + 2, invalid);
     int parity = 0;
-    for (int y = disparity.rows - 1; y >= 0; --y) {
-        float *row = disparity.ptr<float>(y);
-        carryRow(row, width_, invalid, carry_[parity ^ 1], carry_[parity]);
-        const std::vector<float>(&cur)[3] = carry_[parity];
+    for (int y = down ? 0 : height - 1; y >= 0 && y < height; y += step) {
+        const float *row = disparity.ptr<float>(y);
+        carryRow(row, width_, invalid, carry[parity ^ 1], carry[parity]);
+        const std::vector<float>(&cur)[3] = carry[parity];
         const int32_t first = rowStart_[static_cast<size_t>(y)], end = rowStart_[static_cast<size_t>(y) + 1];
-        // The right direction, walking the row's invalid pixels backwards with the row.
-        float right = invalid;
-        int32_t k = end - 1;
-        for (int x = width_ - 1; x >= 0 && k >= first; --x) {
-            if (row[x] != invalid) {
-                right = row[x];
-                continue;
-            }
-            float *v = values_.data() + static_cast<size_t>(k) * kDirections;
+        // The row's direction, its invalid pixels walked from that side: the pixel's
+        // neighbour on that side when valid, else (within a run) what the run's pixel
+        // before it has; nothing at the border.
+        float along = invalid;
+        for (int32_t i = 0; i < end - first; ++i) {
+            const size_t k = static_cast<size_t>(down ? first + i : end - 1 - i);
+            const int x = column_[k], n = x + side;
+            if (n < 0 || n >= width_) along = invalid;
+            else if (row[n] != invalid) along = row[n];
+            float *v = values_.data() + k * kDirections + slot;
             const size_t at = static_cast<size_t>(x) + 1;
-            v[4] = right;
-            v[5] = cur[0][at];
-            v[6] = cur[1][at];
-            v[7] = cur[2][at];
-            --k;
+            v[0] = along;
+            v[1] = cur[0][at];
+            v[2] = cur[1][at];
+            v[3] = cur[2][at];
         }
-        fillRow(row, filled.ptr<uint8_t>(y), y, invalid, occlusionJumpPx);
         parity ^= 1;
     }
 }
 
 // Row y's invalid pixels, run by run: an occlusion takes the second lowest of its
-// directions' values, a mismatch their median (sgm_fill.hpp).
+// directions' values, a mismatch their median, a run at the left border the row's
+// value on its right (sgm_fill.hpp).
 void Filler::fillRow(float *row, uint8_t *filledRow, int y, float invalid, float occlusionJumpPx) {
     const int32_t first = rowStart_[static_cast<size_t>(y)], end = rowStart_[static_cast<size_t>(y) + 1];
     bool occluded = false;
@@ -121,11 +141,15 @@ void Filler::fillRow(float *row, uint8_t *filledRow, int y, float invalid, float
             occluded = v[0] == invalid || (v[4] != invalid && v[4] > v[0] + occlusionJumpPx);
         float found[kDirections];
         int n = 0;
-        for (int d = 0; d < kDirections; ++d)
-            if (v[d] != invalid) found[n++] = v[d];
+        for (int d = 0; d < kDirections; ++d) {
+            const bool valid = v[d] != invalid;
+            found[d] = valid ? v[d] : std::numeric_limits<float>::infinity();
+            n += valid;
+        }
         if (n == 0) continue; // nothing valid in any direction: stays invalid
-        sortSmall(found, n);
-        if (occluded) row[x] = found[n > 1 ? 1 : 0];
+        sort8(found);
+        if (v[0] == invalid && v[4] != invalid) row[x] = v[4]; // the left border: the row's value on its right
+        else if (occluded) row[x] = found[n > 1 ? 1 : 0];
         else row[x] = n % 2 ? found[n / 2] : 0.5f * (found[n / 2 - 1] + found[n / 2]);
         filledRow[x] = 255;
     }

@@ -122,6 +122,15 @@ public:
 
     std::pair<int32_t, int32_t> disparityRange() const override { return {minDisparity_, numDisparities_}; }
 
+    // With fill: dense, the pixels filled in (255) rather than matched (0).
+    std::vector<binocle_named_image> extras() override {
+        const cv::Mat &filled = engine_->filled();
+        if (filled.empty()) return {};
+        const binocle_image plane{filled.cols, filled.rows, static_cast<int32_t>(filled.step[0]), BINOCLE_PIXEL_GRAY8,
+                                  filled.data};
+        return {{"disparity_filled", plane}};
+    }
+
 private:
     // The kernel table named by `kernels`, refused when this CPU or build lacks it.
     static const sgm::Kernels &kernelsOf(const binocle::sdk::CheckedParams &p) {
