@@ -40,6 +40,12 @@ TEST(Isolation, ResultsEqualThoseInProcess) {
         cv::Mat a = isolated->compute(left, left), b = local->compute(left, left);
         ASSERT_EQ(a.size(), size);
         EXPECT_EQ(cv::countNonZero(a != b), 0) << size;
+        // The matcher's extra plane crosses too (after the disparity, in the shared memory).
+        ASSERT_EQ(isolated->extras().size(), 1u) << size;
+        ASSERT_EQ(local->extras().size(), 1u) << size;
+        EXPECT_EQ(isolated->extras()[0].name, "mock_unmatched");
+        EXPECT_EQ(cv::countNonZero(isolated->extras()[0].image != local->extras()[0].image), 0) << size;
+        EXPECT_EQ(cv::countNonZero(local->extras()[0].image), 3 * size.height) << size;
     }
     EXPECT_EQ(isolated->disparityRange(), local->disparityRange());
 }
