@@ -29,8 +29,10 @@ public:
 
 namespace {
 
-// The most planes a matcher may attach to a disparity.
+// The most planes a matcher may attach to a disparity, and their most bytes: two FLOAT32
+// planes' worth (the room isolation's shared memory keeps for them).
 constexpr int32_t kMaxExtras = 64;
+constexpr size_t kExtrasFloatPlanes = 2;
 
 // A matcher's extras checked as matcher.h states them (named, unique, of the disparity's
 // size, GRAY8, GRAY16 or FLOAT32), then copied: the plugin keeps its own until its next
@@ -41,6 +43,8 @@ void copyExtras(const PluginRecord &record, const binocle_named_image *list, int
     if (count < 0 || count > kMaxExtras || (count > 0 && !list))
         refuse("returned " + std::to_string(count) + " planes" + (list ? "" : " and no list") + ": expected 0 .. " +
                std::to_string(kMaxExtras) + ", with a list when more than 0");
+    const size_t room = kExtrasFloatPlanes * size.area() * sizeof(float);
+    size_t bytes = 0;
     for (int32_t i = 0; i < count; ++i) {
         const binocle_named_image &e = list[i];
         const std::string name = e.name ? e.name : "";
@@ -57,6 +61,10 @@ void copyExtras(const PluginRecord &record, const binocle_named_image *list, int
         if (e.image.width != size.width || e.image.height != size.height)
             refuse(what + " is " + std::to_string(e.image.width) + "x" + std::to_string(e.image.height) + ": expected " +
                    std::to_string(size.width) + "x" + std::to_string(size.height) + ", the disparity's size");
+        bytes += static_cast<size_t>(e.image.width) * e.image.height * bytesPerPixel(f);
+        if (bytes > room)
+            refuse("planes up to '" + name + "' hold " + std::to_string(bytes) + " bytes: expected at most " +
+                   std::to_string(room) + ", two FLOAT32 planes of the disparity's size");
         out.push_back({name, view(e.image).clone()});
     }
 }
@@ -103,9 +111,9 @@ public:
         const size_t rowBytes = left.cols * left.elemSize();
         c.image_bytes = pageAligned(rowBytes * left.rows);
         const size_t dispBytes = pageAligned(static_cast<size_t>(left.cols) * left.rows * sizeof(float));
-        // Room for the matcher's extras after the disparity: two FLOAT32 planes' worth
-        // (pages never written cost nothing).
-        c.extras_bytes = 2 * dispBytes;
+        // Room for the matcher's extras after the disparity: two FLOAT32 planes' worth (as
+        // copyExtras allows), and each plane's alignment (pages never written cost nothing).
+        c.extras_bytes = kExtrasFloatPlanes * dispBytes + kMaxExtras * 64;
         const bool done = guarded([&] {
             uint8_t *base = shared_.reserve(2 * c.image_bytes + dispBytes + c.extras_bytes);
             // The one copy of the pixels: into the shared mapping the helper process reads.
@@ -166,7 +174,7 @@ public:
         if (layout.bytes() > c.extras_bytes)
             throw Error("matcher '" + instance_.record().name + "': its extras need " + std::to_string(layout.bytes()) +
                         " bytes of shared memory, more than the " + std::to_string(c.extras_bytes) +
-                        " the host gives them (two FLOAT32 planes of the disparity's size)");
+                        " the host gives them");
         layout.copyInto(m.base + extrasAt);
     }
 };

@@ -50,6 +50,26 @@ TEST(Isolation, ResultsEqualThoseInProcess) {
     EXPECT_EQ(isolated->disparityRange(), local->disparityRange());
 }
 
+// A matcher's extra planes are checked as matcher.h states them, in process and in a
+// helper process alike: of the disparity's size, at most two FLOAT32 planes' worth.
+TEST(Isolation, MatcherExtrasAreCheckedInProcessAndIsolated) {
+    cv::Mat left(8, 8, CV_8UC1, cv::Scalar(0));
+    for (const bool isolated : {false, true}) {
+        auto half = isolated ? isolatedMatcher("faulty_matcher", "{fault: extras}")
+                             : newInstance<Matcher>("faulty_matcher", BINOCLE_KIND_MATCHER, "{fault: extras}");
+        const std::string msg = pluginErrorOf([&] { half->compute(left, left); });
+        EXPECT_THAT(msg, HasSubstr("matcher plugin 'faulty_matcher'")) << isolated;
+        EXPECT_THAT(msg, HasSubstr("extras failed (BINOCLE_ERR_INTERNAL): plane 'half' is 4x8: expected 8x8, the "
+                                   "disparity's size")) << isolated;
+        EXPECT_TRUE(half->extras().empty());
+        auto many = isolated ? isolatedMatcher("faulty_matcher", "{fault: many_extras}")
+                             : newInstance<Matcher>("faulty_matcher", BINOCLE_KIND_MATCHER, "{fault: many_extras}");
+        EXPECT_THAT(pluginErrorOf([&] { many->compute(left, left); }),
+                    HasSubstr("planes up to 'c' hold 768 bytes: expected at most 512, two FLOAT32 planes of the "
+                              "disparity's size")) << isolated;
+    }
+}
+
 TEST(Isolation, ThePluginsOwnErrorsCrossWithTheirCode) {
     auto m = isolatedMatcher("faulty_matcher", "{fault: throw}");
     cv::Mat left(8, 8, CV_8UC1, cv::Scalar(0));
