@@ -4,6 +4,7 @@
 //  - speed at 640 x 480 (the aloe pair, resized) with 64 and 128 disparities, and on the
 //    full-size aloe pair (1282 x 1110, 256 disparities): sgm (its defaults), sgbm in its
 //    fastest mode (sgbm_3way, block 5) and bm (block 15); ratios printed as counters;
+//  - the same for sgm with `fill: dense` against sgm without it (SgmSpeedDense);
 //  - accuracy on the full-size aloe pair against aloeGT.png: bad-2, density, bad-2
 //    counting holes as errors, mean end-point error, for the three.
 //   build/bench/binocle_bench --benchmark_filter=Sgm
@@ -49,20 +50,26 @@ bool loadAloe(cv::Mat &left, cv::Mat &right, cv::Mat &truth) {
     return !left.empty() && !right.empty() && !truth.empty();
 }
 
-// Args: width (0 = the full-size pair), num_disparities.
-void BM_SgmSpeedVersusOpenCv(benchmark::State &state) {
-    cv::Mat left, right, truth;
+// The aloe pair at the bench's size: args width (0 = the full-size pair).
+bool loadSpeedPair(benchmark::State &state, cv::Mat &left, cv::Mat &right) {
+    cv::Mat truth;
     if (!loadAloe(left, right, truth)) {
         state.SkipWithError("the opencv-doc aloe pair is missing");
-        return;
+        return false;
     }
     if (state.range(0) > 0) {
         const cv::Size size(static_cast<int>(state.range(0)), static_cast<int>(state.range(0)) * 3 / 4);
         cv::resize(left, left, size, 0, 0, cv::INTER_AREA);
         cv::resize(right, right, size, 0, 0, cv::INTER_AREA);
     }
+    return true;
+}
+
+// The contenders interleaved frame by frame (args: width, num_disparities); each one's
+// mean time a frame in ms as a counter <label>_ms; returns each one's total seconds.
+std::vector<double> timeInterleaved(benchmark::State &state, const std::vector<Contender> &all, const cv::Mat &left,
+                                    const cv::Mat &right) {
     const std::string disparities = "num_disparities: " + std::to_string(state.range(1)) + "}";
-    std::vector<Contender> all = contenders();
     std::vector<std::unique_ptr<binocle::Matcher>> matchers;
     for (const Contender &c : all) matchers.push_back(matcher(c.plugin, c.yaml + disparities));
     std::vector<cv::Mat> out(all.size());
@@ -82,12 +89,32 @@ void BM_SgmSpeedVersusOpenCv(benchmark::State &state) {
     }
     const double n = static_cast<double>(state.iterations());
     for (size_t i = 0; i < all.size(); ++i) state.counters[std::string(all[i].label) + "_ms"] = 1e3 * seconds[i] / n;
-    state.counters["sgm_fps_over_sgbm_3way"] = seconds[1] / seconds[0];
-    state.counters["sgm_fps_over_bm"] = seconds[2] / seconds[0];
     state.SetLabel(std::to_string(left.cols) + "x" + std::to_string(left.rows) + ", " +
                    std::to_string(state.range(1)) + " disparities, " + std::to_string(cv::getNumThreads()) + " threads");
+    return seconds;
+}
+
+// Args: width (0 = the full-size pair), num_disparities.
+void BM_SgmSpeedVersusOpenCv(benchmark::State &state) {
+    cv::Mat left, right;
+    if (!loadSpeedPair(state, left, right)) return;
+    const std::vector<double> seconds = timeInterleaved(state, contenders(), left, right);
+    state.counters["sgm_fps_over_sgbm_3way"] = seconds[1] / seconds[0];
+    state.counters["sgm_fps_over_bm"] = seconds[2] / seconds[0];
 }
 BENCHMARK(BM_SgmSpeedVersusOpenCv)->Args({640, 64})->Args({640, 128})->Args({0, 256})
+    ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+// sgm with `fill: dense` against sgm without it (its defaults), interleaved: the time of
+// a dense frame over a sparse one (issue 34's bar: within 1.10 at 640 x 480 x 128).
+void BM_SgmSpeedDense(benchmark::State &state) {
+    cv::Mat left, right;
+    if (!loadSpeedPair(state, left, right)) return;
+    const std::vector<double> seconds =
+        timeInterleaved(state, {{"sgm", "sgm", "{"}, {"sgm_dense", "sgm", "{fill: dense, "}}, left, right);
+    state.counters["dense_time_over_sgm"] = seconds[1] / seconds[0];
+}
+BENCHMARK(BM_SgmSpeedDense)->Args({640, 64})->Args({640, 128})
     ->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
 // Full-size aloe, 256 disparities (configs/rigs/opencv-aloe.yaml's): each matcher scored as

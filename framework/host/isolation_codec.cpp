@@ -285,15 +285,30 @@ uint8_t *arrayAt(uint64_t offset, uint64_t length, Region region) {
     return region.base + offset;
 }
 
+void putNamedImages(Writer &w, Layout &layout, const binocle_named_image *images, int32_t count) {
+    w.put<int32_t>(count);
+    for (int32_t i = 0; i < count; ++i) {
+        w.str(images[i].name ? images[i].name : "");
+        putImage(w, layout.place(images[i].image));
+    }
+}
+
+void getNamedImages(Reader &r, Region region, NamedImages &out) {
+    const auto count = r.get<int32_t>();
+    if (count < 0 || count > 64) throw Error("malformed list of planes between Binocle and its plugin helper");
+    out.images.clear();
+    out.names.clear();
+    for (int32_t i = 0; i < count; ++i) {
+        out.names.push_back(r.str());
+        out.images.push_back({out.names.back().c_str(), getImage(r, region)});
+    }
+}
+
 void putFrame(Writer &w, Layout &layout, const binocle_stereo_frame &f) {
     w.put<uint64_t>(f.sequence).put<int64_t>(f.timestamp_left_ns).put<int64_t>(f.timestamp_right_ns);
     putImage(w, layout.place(f.left));
     putImage(w, layout.place(f.right));
-    w.put<int32_t>(f.extra_count);
-    for (int32_t i = 0; i < f.extra_count; ++i) {
-        w.str(f.extras[i].name ? f.extras[i].name : "");
-        putImage(w, layout.place(f.extras[i].image));
-    }
+    putNamedImages(w, layout, f.extras, f.extra_count);
     w.cstr(f.metadata);
 }
 
@@ -305,16 +320,9 @@ binocle_stereo_frame getFrame(Reader &r, Region region, FrameTexts &texts) {
     f.timestamp_right_ns = r.get<int64_t>();
     f.left = getImage(r, region);
     f.right = getImage(r, region);
-    const auto count = r.get<int32_t>();
-    if (count < 0 || count > 64) throw Error("malformed frame between Binocle and its plugin helper");
-    texts.extras.clear();
-    texts.names.clear();
-    for (int32_t i = 0; i < count; ++i) {
-        texts.names.push_back(r.str());
-        texts.extras.push_back({texts.names.back().c_str(), getImage(r, region)});
-    }
-    f.extras = texts.extras.empty() ? nullptr : texts.extras.data();
-    f.extra_count = count;
+    getNamedImages(r, region, texts.extras);
+    f.extras = texts.extras.images.empty() ? nullptr : texts.extras.images.data();
+    f.extra_count = static_cast<int32_t>(texts.extras.images.size());
     const auto [hasMetadata, metadata] = r.cstr();
     texts.metadata = metadata;
     f.metadata = hasMetadata ? texts.metadata.c_str() : nullptr;
@@ -373,6 +381,8 @@ void putEvaluate(Writer &w, Layout &layout, const binocle_eval_input &in, bool s
     // What the host knows of the matcher's search and the ground pose (appended members).
     w.put<int32_t>(in.min_disparity).put<int32_t>(in.num_disparities).put<int32_t>(in.ground_pose_known);
     w.put<double>(in.camera_height_mm).put<double>(in.inclination_deg);
+    // The matcher's planes (appended members).
+    putNamedImages(w, layout, in.disparity_extras, in.disparity_extras ? in.disparity_extra_count : 0);
 }
 
 void getEvaluate(Reader &r, Region region, EvaluateTexts &texts, EvaluateInput &out) {
@@ -395,6 +405,9 @@ void getEvaluate(Reader &r, Region region, EvaluateTexts &texts, EvaluateInput &
     in.ground_pose_known = r.get<int32_t>();
     in.camera_height_mm = r.get<double>();
     in.inclination_deg = r.get<double>();
+    getNamedImages(r, region, out.disparityExtras);
+    in.disparity_extras = out.disparityExtras.images.empty() ? nullptr : out.disparityExtras.images.data();
+    in.disparity_extra_count = static_cast<int32_t>(out.disparityExtras.images.size());
     in.struct_size = sizeof in;
     in.frame = hasFrame ? &out.frame : nullptr;
     in.rectified_left = has[0] ? &out.images[0] : nullptr;

@@ -254,12 +254,21 @@ binocle_image getImage(Reader &r, Region region);
 // The array at an offset of the region, checked to lie within it.
 uint8_t *arrayAt(uint64_t offset, uint64_t length, Region region);
 
+// Named planes (a frame's extras, a matcher's extras) placed in a Layout: their count,
+// then each one's name and image.
+void putNamedImages(Writer &w, Layout &layout, const binocle_named_image *images, int32_t count);
+// Decoded: the images point into the region, the names into `names`.
+struct NamedImages {
+    std::vector<binocle_named_image> images;
+    std::deque<std::string> names; // a deque: pointers into it stay valid as it grows
+};
+void getNamedImages(Reader &r, Region region, NamedImages &out);
+
 // A frame whose planes are placed in a Layout.
 void putFrame(Writer &w, Layout &layout, const binocle_stereo_frame &f);
-// What a decoded frame points into besides the region: extra plane names, metadata.
+// What a decoded frame points into besides the region: extra planes, metadata.
 struct FrameTexts {
-    std::vector<binocle_named_image> extras;
-    std::deque<std::string> names; // a deque: pointers into it stay valid as it grows
+    NamedImages extras;
     std::string metadata;
 };
 binocle_stereo_frame getFrame(Reader &r, Region region, FrameTexts &texts);
@@ -271,13 +280,17 @@ binocle_cloud getCloud(Reader &r, Region region);
 // ---- The kinds' calls ----------------------------------------------------------------------
 
 // Matcher compute: left and right at 0 and image_bytes, the disparity (CV_32F) at
-// 2 * image_bytes; images tightly packed.
+// 2 * image_bytes; images tightly packed. The matcher's extras go after the disparity
+// (at its page-aligned end), within extras_bytes; the reply describes them
+// (putNamedImages, offsets from there).
 struct ComputeRequest {
     int32_t width = 0, height = 0, cv_type = 0;
     uint64_t image_bytes = 0;
+    uint64_t extras_bytes = 0;
 };
 constexpr auto wireFields(const ComputeRequest *) {
-    return std::make_tuple(&ComputeRequest::width, &ComputeRequest::height, &ComputeRequest::cv_type, &ComputeRequest::image_bytes);
+    return std::make_tuple(&ComputeRequest::width, &ComputeRequest::height, &ComputeRequest::cv_type,
+                           &ComputeRequest::image_bytes, &ComputeRequest::extras_bytes);
 }
 
 // Matcher disparity_range's reply.
@@ -311,6 +324,7 @@ struct EvaluateInput {
     binocle_eval_input in{};
     binocle_stereo_frame frame{};
     FrameTexts frameTexts;
+    NamedImages disparityExtras;
     binocle_image images[3]{};
     binocle_cloud cloud{};
     std::pair<bool, std::string> output{false, ""};

@@ -187,6 +187,13 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+// A plane a matcher attached to its disparity (matcher.h: extras), e.g.
+// "disparity_filled": the host's copy, of the disparity's size (CV_8U, CV_16U or CV_32F).
+struct NamedPlane {
+    std::string name;
+    cv::Mat image;
+};
+
 class Matcher : public PluginInstanceBase {
 public:
     // In this process, or in a helper process when params.isolation().process.
@@ -203,11 +210,16 @@ public:
     void computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity);
     // Disparities made invalid so far because they were not finite or absurd.
     uint64_t invalidatedDisparities() const { return invalidated_; }
+    // The planes the plugin attached to the last compute's disparity (none when its table
+    // has no extras entry, or after a failed compute): new buffers each compute, so a
+    // copy of the list stays valid.
+    const std::vector<NamedPlane> &extras() const { return extras_; }
 
     class Impl;
 
 private:
     std::unique_ptr<Impl> impl_;
+    std::vector<NamedPlane> extras_;
     uint64_t invalidated_ = 0;
     bool warnedInvalid_ = false;
 };

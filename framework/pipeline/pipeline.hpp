@@ -54,6 +54,8 @@ struct FrameResult {
     const LentFrame *frame = nullptr; // as the source lent it (extras, metadata)
     cv::Mat rectified_left, rectified_right;
     cv::Mat disparity; // CV_32F
+    // The planes the matcher attached to it (e.g. "disparity_filled"): handed to evaluators.
+    std::vector<NamedPlane> disparity_extras;
     double valid_pixel_ratio = 0; // share of pixels with a disparity
     Cloud cloud;       // after transforms
     nlohmann::ordered_json metrics; // {evaluator: {metric: value}}

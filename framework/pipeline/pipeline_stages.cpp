@@ -166,6 +166,7 @@ void Pipeline::rectifyAndMatch(RunState &s, size_t instance) {
                 r.stage_seconds.emplace_back("rectify", secondsSince(t0));
                 const auto t1 = Clock::now();
                 matcher.compute(r.rectified_left, r.rectified_right, r.disparity);
+                r.disparity_extras = matcher.extras(); // new buffers each compute: a shallow copy
                 r.stage_seconds.emplace_back("match", secondsSince(t1));
                 r.seconds += secondsSince(t0);
             } catch (const std::exception &e) {
@@ -225,7 +226,10 @@ void Pipeline::evaluate(RunState &s) {
                     im.width = m.cols;
                     im.height = m.rows;
                     im.stride_bytes = static_cast<int32_t>(m.step[0]);
-                    im.format = m.type() == CV_32F ? BINOCLE_PIXEL_FLOAT32 : m.channels() == 3 ? BINOCLE_PIXEL_BGR8 : BINOCLE_PIXEL_GRAY8;
+                    im.format = m.type() == CV_32F   ? BINOCLE_PIXEL_FLOAT32
+                                : m.type() == CV_16U ? BINOCLE_PIXEL_GRAY16
+                                : m.channels() == 3  ? BINOCLE_PIXEL_BGR8
+                                                     : BINOCLE_PIXEL_GRAY8;
                     im.data = m.data;
                 };
                 wrap(r.rectified_left, rl);
@@ -245,6 +249,14 @@ void Pipeline::evaluate(RunState &s) {
                 in.min_disparity = disparityRange_.first;
                 in.num_disparities = disparityRange_.second;
                 putGroundPose(in, rig_);
+                std::vector<binocle_named_image> extras;
+                for (const NamedPlane &p : r.disparity_extras) {
+                    binocle_image im{};
+                    wrap(p.image, im);
+                    extras.push_back({p.name.c_str(), im});
+                }
+                in.disparity_extras = extras.empty() ? nullptr : extras.data();
+                in.disparity_extra_count = static_cast<int32_t>(extras.size());
                 for (const auto &slot : evaluators) {
                     Json figures = Json::object();
                     slot->target = &figures;

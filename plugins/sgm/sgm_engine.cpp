@@ -13,6 +13,10 @@
 namespace sgm {
 namespace {
 
+// The dense option's occlusion test: a run of invalid pixels is an occlusion when the
+// disparity on its right exceeds the one on its left by more than this (sgm_fill.hpp).
+constexpr float kOcclusionJumpPx = 1.0f;
+
 std::string mebibytes(double bytes) { return std::to_string(static_cast<long long>(std::ceil(bytes / 1048576.0))); }
 
 } // namespace
@@ -53,7 +57,9 @@ double Engine::workingBytes(int width, int height) const {
                           w * dp * 4 /* horizontal paths (4 paths) or a row of sums */ + 8 * w +
                           8.0 * kernels_.costScratchWords(width, settings_.minDisparity, paddedDisp_) +
                           2.0 * medianScratch(width);
-    return volume + images + stripes * stripe;
+    // The dense option, at worst every pixel invalid: its column and 8 values, the mark.
+    const double fill = settings_.fillDense ? w * h * (4 + 8 * 4 + 1) : 0;
+    return volume + images + stripes * stripe + fill;
 }
 
 void Engine::prepare(int width, int height) {
@@ -275,6 +281,7 @@ void Engine::run(const cv::Mat &left, const cv::Mat &right, cv::Mat *disparity, 
         for (int y = std::max(0, border - k); y < std::min(height_, border + k); ++y)
             medianRow(stripes_[0], y, *disparity, invalid);
     }
+    if (settings_.fillDense) filler_.fill(*disparity, invalid, kOcclusionJumpPx, filled_);
 }
 
 const cv::Mat &Engine::computeFixed(const cv::Mat &left, const cv::Mat &right) {

@@ -3,6 +3,7 @@
 // the plugin ABI (the plugin wraps it), so tests can drive it with any kernel table.
 #pragma once
 
+#include "sgm_fill.hpp"
 #include "sgm_kernels.hpp"
 
 #include <cstddef>
@@ -48,6 +49,7 @@ struct Settings {
     bool subpixel = true;
     int medianPx = 5;           // 1: none
     int stripes = 2;
+    bool fillDense = false;     // fill the invalid pixels after the median (sgm_fill.hpp)
     double maxMemoryBytes = 2048.0 * 1048576.0;
 };
 
@@ -66,6 +68,10 @@ public:
     // The same, stopping before the median filter and the conversion: (minD + d) * 16,
     // 0 = invalid. For tests.
     const cv::Mat &computeFixed(const cv::Mat &left, const cv::Mat &right);
+
+    // After compute with fillDense: 255 where the value was filled in, 0 where matched
+    // (CV_8UC1, the disparity's size); empty without fillDense.
+    const cv::Mat &filled() const { return filled_; }
 
     // Bytes of working memory a width x height pair needs (what max_memory_mb bounds).
     double workingBytes(int width, int height) const;
@@ -126,6 +132,8 @@ private:
     AlignedVector<uint8_t> downPath_; // 4 paths: the pass down's vertical path (path-row layout)
     AlignedVector<uint8_t> costVolume_; // and its costs, which the pass up reads again
     std::vector<Stripe> stripes_;
+    Filler filler_;
+    cv::Mat filled_;
     int allocations_ = 0;
 };
 

@@ -53,6 +53,8 @@ public:
                 .help("refine each disparity by a parabola through the neighbouring sums (1/16 px)"),
             Param::integer("median_px", "5").min(1).max(5).odd().unit("px")
                 .help("side of the median filter on the disparity; 1 = none"),
+            Param::choice("fill", "none", "none|dense")
+                .help("none: pixels no match survived for stay invalid; dense: each is filled (Hirschmueller 2008): an occlusion from the background side (second lowest of the nearest valid disparities along 8 directions), a mismatch from all sides (their median); the extra plane disparity_filled marks them"),
             Param::integer("stripes", "2").min(1).max(64)
                 .help("horizontal stripes matched in parallel (each warms its paths up on 16 rows of the next); the result depends on it, not on the thread count"),
             Param::integer("max_memory_mb", "2048").min(16).max(1048576).unit("MiB")
@@ -81,6 +83,7 @@ public:
         s.subpixel = p.boolean("subpixel");
         s.medianPx = static_cast<int>(p.integer("median_px"));
         s.stripes = static_cast<int>(p.integer("stripes"));
+        s.fillDense = p.string("fill") == "dense";
         s.maxMemoryBytes = static_cast<double>(p.integer("max_memory_mb")) * 1048576.0;
         // Rules across settings, in the same words.
         const int bits = sgm::censusBits(s.censusWidth, s.censusHeight, s.censusSymmetric);
@@ -118,6 +121,15 @@ public:
     }
 
     std::pair<int32_t, int32_t> disparityRange() const override { return {minDisparity_, numDisparities_}; }
+
+    // With fill: dense, the pixels filled in (255) rather than matched (0).
+    std::vector<binocle_named_image> extras() override {
+        const cv::Mat &filled = engine_->filled();
+        if (filled.empty()) return {};
+        const binocle_image plane{filled.cols, filled.rows, static_cast<int32_t>(filled.step[0]), BINOCLE_PIXEL_GRAY8,
+                                  filled.data};
+        return {{"disparity_filled", plane}};
+    }
 
 private:
     // The kernel table named by `kernels`, refused when this CPU or build lacks it.

@@ -258,7 +258,7 @@ TEST(IsolationCodec, CloudRoundTripsWithAndWithoutItsOptionalArrays) {
 
 TEST(IsolationCodec, TheKindsCallsRoundTrip) {
     wire::Writer w;
-    wire::put(w, wire::ComputeRequest{640, 480, 16, 4096 * 80});
+    wire::put(w, wire::ComputeRequest{640, 480, 16, 4096 * 80, 4096 * 600});
     wire::putGrabRequest(w, -1);
     wire::put(w, wire::AppliedCloud{12, BINOCLE_FRAME_CAMERA, 64, 0, 192});
     wire::Reader r(w.data());
@@ -267,6 +267,7 @@ TEST(IsolationCodec, TheKindsCallsRoundTrip) {
     EXPECT_EQ(c.height, 480);
     EXPECT_EQ(c.cv_type, 16);
     EXPECT_EQ(c.image_bytes, 4096u * 80);
+    EXPECT_EQ(c.extras_bytes, 4096u * 600);
     EXPECT_EQ(wire::getGrabRequest(r), -1);
     const auto a = wire::get<wire::AppliedCloud>(r);
     EXPECT_EQ(a.count, 12);
@@ -296,6 +297,10 @@ TEST(IsolationCodec, EvaluateRoundTripsAndKeepsTextsNotSentAgain) {
     in.ground_pose_known = 1;
     in.camera_height_mm = 1234.5;
     in.inclination_deg = 7.25;
+    StridedImage filled(4, 2, 6, 255);
+    const binocle_named_image extras[] = {{"disparity_filled", filled.image}};
+    in.disparity_extras = extras;
+    in.disparity_extra_count = 1;
     wire::EvaluateTexts kept;
     for (bool send : {true, false}) {
         wire::Layout layout;
@@ -320,6 +325,9 @@ TEST(IsolationCodec, EvaluateRoundTripsAndKeepsTextsNotSentAgain) {
         EXPECT_EQ(got.in.ground_pose_known, 1);
         EXPECT_EQ(got.in.camera_height_mm, 1234.5);
         EXPECT_EQ(got.in.inclination_deg, 7.25);
+        ASSERT_EQ(got.in.disparity_extra_count, 1);
+        EXPECT_STREQ(got.in.disparity_extras[0].name, "disparity_filled");
+        EXPECT_EQ(pixels(got.in.disparity_extras[0].image), pixels(filled.image));
         EXPECT_TRUE(r.atEnd());
     }
 }

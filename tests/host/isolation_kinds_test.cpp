@@ -387,7 +387,8 @@ TEST_F(IsolatedRunKinds, EveryKindIsolatedGivesTheSameOutputsAsInProcess) {
         return "source:\n  plugin: faulty_source\n  fault: none\n  frames: 3\n" + isolation +
                "matcher:\n  plugin: mock_matcher\n  mode: shift\n  disparity_px: 4\n" + isolation +
                "transforms:\n  - plugin: faulty_transform\n    fault: none\n" + (isolation.empty() ? "" : "  ") + isolation +
-               "evaluators:\n  - plugin: faulty_evaluator\n    fault: none\n" + (isolation.empty() ? "" : "  ") + isolation;
+               "evaluators:\n  - plugin: faulty_evaluator\n    fault: none\n" + (isolation.empty() ? "" : "  ") + isolation +
+               "  - plugin: mock_evaluator\n" + (isolation.empty() ? "" : "  ") + isolation;
     };
     ProcessResult a = run(rig(""), "local");
     ASSERT_EQ(a.exit_code, 0) << a.err;
@@ -409,6 +410,11 @@ TEST_F(IsolatedRunKinds, EveryKindIsolatedGivesTheSameOutputsAsInProcess) {
     int lines = 0;
     for (std::string x, y; std::getline(la, x) && std::getline(lb, y); ++lines) {
         nlohmann::json ja = nlohmann::json::parse(x), jb = nlohmann::json::parse(y);
+        // The evaluator saw the matcher's extra plane, in process and isolated alike: 4
+        // columns of the source's 64.
+        for (const nlohmann::json *j : {&ja, &jb})
+            EXPECT_DOUBLE_EQ((*j)["metrics"]["mock_evaluator"]["mock_unmatched_nonzero_percent"].get<double>(), 100.0 * 4 / 64)
+                << *j;
         auto &ea = ja["metrics"]["faulty_evaluator"], &eb = jb["metrics"]["faulty_evaluator"];
         EXPECT_EQ(YAML::Load(ea["metadata"].get<std::string>())["sequence"].as<int>(),
                   YAML::Load(eb["metadata"].get<std::string>())["sequence"].as<int>());

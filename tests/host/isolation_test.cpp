@@ -40,8 +40,34 @@ TEST(Isolation, ResultsEqualThoseInProcess) {
         cv::Mat a = isolated->compute(left, left), b = local->compute(left, left);
         ASSERT_EQ(a.size(), size);
         EXPECT_EQ(cv::countNonZero(a != b), 0) << size;
+        // The matcher's extra plane crosses too (after the disparity, in the shared memory).
+        ASSERT_EQ(isolated->extras().size(), 1u) << size;
+        ASSERT_EQ(local->extras().size(), 1u) << size;
+        EXPECT_EQ(isolated->extras()[0].name, "mock_unmatched");
+        EXPECT_EQ(cv::countNonZero(isolated->extras()[0].image != local->extras()[0].image), 0) << size;
+        EXPECT_EQ(cv::countNonZero(local->extras()[0].image), 3 * size.height) << size;
     }
     EXPECT_EQ(isolated->disparityRange(), local->disparityRange());
+}
+
+// A matcher's extra planes are checked as matcher.h states them, in process and in a
+// helper process alike: of the disparity's size, at most two FLOAT32 planes' worth.
+TEST(Isolation, MatcherExtrasAreCheckedInProcessAndIsolated) {
+    cv::Mat left(8, 8, CV_8UC1, cv::Scalar(0));
+    for (const bool isolated : {false, true}) {
+        auto half = isolated ? isolatedMatcher("faulty_matcher", "{fault: extras}")
+                             : newInstance<Matcher>("faulty_matcher", BINOCLE_KIND_MATCHER, "{fault: extras}");
+        const std::string msg = pluginErrorOf([&] { half->compute(left, left); });
+        EXPECT_THAT(msg, HasSubstr("matcher plugin 'faulty_matcher'")) << isolated;
+        EXPECT_THAT(msg, HasSubstr("extras failed (BINOCLE_ERR_INTERNAL): plane 'half' is 4x8: expected 8x8, the "
+                                   "disparity's size")) << isolated;
+        EXPECT_TRUE(half->extras().empty());
+        auto many = isolated ? isolatedMatcher("faulty_matcher", "{fault: many_extras}")
+                             : newInstance<Matcher>("faulty_matcher", BINOCLE_KIND_MATCHER, "{fault: many_extras}");
+        EXPECT_THAT(pluginErrorOf([&] { many->compute(left, left); }),
+                    HasSubstr("planes up to 'c' hold 768 bytes: expected at most 512, two FLOAT32 planes of the "
+                              "disparity's size")) << isolated;
+    }
 }
 
 TEST(Isolation, ThePluginsOwnErrorsCrossWithTheirCode) {

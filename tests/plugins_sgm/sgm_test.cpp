@@ -49,6 +49,32 @@ TEST(SgmPlugin, KernelsAgreeThroughThePlugin) {
     }
 }
 
+// fill: dense leaves no pixel invalid and marks the filled ones in the extra plane
+// "disparity_filled", which evaluators receive (matcher.h: extras): exactly the pixels
+// sgm without it leaves invalid; the matched ones keep their values. Without it, no plane.
+TEST(SgmPlugin, DenseFillsTheHolesAndMarksThem) {
+    const AloePair a = loadAloe();
+    cv::Mat left, right;
+    cv::resize(a.left, left, cv::Size(320, 277), 0, 0, cv::INTER_AREA);
+    cv::resize(a.right, right, left.size(), 0, 0, cv::INTER_AREA);
+    Matcher sparse = makeMatcher("sgm", "{num_disparities: 64}");
+    Matcher dense = makeMatcher("sgm", "{num_disparities: 64, fill: dense}");
+    const cv::Mat s = sparse.compute(left, right), d = dense.compute(left, right);
+    EXPECT_TRUE(sparse.extras().empty());
+    ASSERT_EQ(dense.extras().size(), 1u);
+    const NamedPlane &filled = dense.extras()[0];
+    EXPECT_EQ(filled.name, "disparity_filled");
+    ASSERT_EQ(filled.image.type(), CV_8UC1);
+    const cv::Mat holes = s <= 0;
+    EXPECT_GT(cv::countNonZero(holes), 0);
+    EXPECT_EQ(cv::countNonZero(filled.image != holes), 0);
+    EXPECT_EQ(cv::countNonZero(d <= 0), 0);
+    const cv::Mat changed = s != d;
+    EXPECT_EQ(cv::countNonZero(changed & ~holes), 0);
+    const std::string refused = errorOf([] { makeMatcher("sgm", "{fill: sparse}"); });
+    EXPECT_NE(refused.find("expected none or dense"), std::string::npos) << refused;
+}
+
 // Columns whose candidates all lie left of the right image have no match: invalid, as
 // the ABI says (BINOCLE_INVALID_DISPARITY).
 TEST(SgmPlugin, MarksPixelsWithoutCandidatesInvalid) {

@@ -113,9 +113,9 @@ if(verdict)
 endif()
 
 # 2. The check tells an append from a break.
-set(end_of_matcher "                                      int32_t *num_disparities);\n} binocle_matcher_api;")
+set(end_of_matcher "                             int32_t *count);\n} binocle_matcher_api;")
 variant("${WORK_DIR}/appended" matcher.h "${end_of_matcher}"
-        "                                      int32_t *num_disparities);\n    void *appended;\n} binocle_matcher_api;")
+        "                             int32_t *count);\n    void *appended;\n} binocle_matcher_api;")
 abi_of("${WORK_DIR}/appended" "${WORK_DIR}/appended.abi")
 compare("${BASELINE}" "${WORK_DIR}/appended.abi")
 if(verdict)

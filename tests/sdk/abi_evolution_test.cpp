@@ -37,6 +37,11 @@ TEST(AbiEvolution, FrozenApi1MatcherLoadsAndComputes) {
     cv::Mat d = m.compute(left, right);
     EXPECT_EQ(cv::countNonZero(d == 5.0f), 32 * 24);
     EXPECT_EQ(m.disparityRange(), (std::pair<int32_t, int32_t>{0, 8}));
+    // Its table ends before `extras` (appended after API 1): the host's copy reads it as
+    // absent and the disparity comes without extra planes.
+    EXPECT_LT(r.table->struct_size, offsetof(binocle_matcher_api, extras) + sizeof(void *));
+    EXPECT_EQ(reinterpret_cast<const binocle_matcher_api *>(r.table)->extras, nullptr);
+    EXPECT_TRUE(m.extras().empty());
 }
 
 TEST(AbiEvolution, FrozenApi1SourceLendsFramesUntilTheEnd) {

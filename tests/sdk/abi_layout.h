@@ -84,7 +84,7 @@
     FIELD(binocle_source_api, calibration, 112)                                    \
     FIELD(binocle_source_api, statistics, 120)                                     \
     FIELD(binocle_source_api, enumerate_devices, 128)                              \
-    SIZE(binocle_matcher_api, 96)                                                  \
+    SIZE(binocle_matcher_api, 104)                                                 \
     FIELD(binocle_matcher_api, header, 0)                                          \
     FIELD(binocle_matcher_api, params, 40)                                         \
     FIELD(binocle_matcher_api, param_count, 48)                                    \
@@ -93,6 +93,7 @@
     FIELD(binocle_matcher_api, last_error, 72)                                     \
     FIELD(binocle_matcher_api, compute, 80)                                        \
     FIELD(binocle_matcher_api, disparity_range, 88)                                \
+    FIELD(binocle_matcher_api, extras, 96)                                         \
     SIZE(binocle_cloud, 48)                                                        \
     FIELD(binocle_cloud, count, 0)                                                 \
     FIELD(binocle_cloud, xyz, 8)                                                   \
@@ -109,7 +110,7 @@
     FIELD(binocle_cloud_transform_api, destroy, 64)                                \
     FIELD(binocle_cloud_transform_api, last_error, 72)                             \
     FIELD(binocle_cloud_transform_api, apply, 80)                                  \
-    SIZE(binocle_eval_input, 104)                                                  \
+    SIZE(binocle_eval_input, 120)                                                  \
     FIELD(binocle_eval_input, struct_size, 0)                                      \
     FIELD(binocle_eval_input, frame, 8)                                            \
     FIELD(binocle_eval_input, rectified_left, 16)                                  \
@@ -124,6 +125,8 @@
     FIELD(binocle_eval_input, ground_pose_known, 80)                               \
     FIELD(binocle_eval_input, camera_height_mm, 88)                                \
     FIELD(binocle_eval_input, inclination_deg, 96)                                 \
+    FIELD(binocle_eval_input, disparity_extras, 104)                               \
+    FIELD(binocle_eval_input, disparity_extra_count, 112)                          \
     SIZE(binocle_evaluator_api, 96)                                                \
     FIELD(binocle_evaluator_api, header, 0)                                        \
     FIELD(binocle_evaluator_api, params, 40)                                       \

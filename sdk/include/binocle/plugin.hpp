@@ -264,6 +264,10 @@ public:
     virtual void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) = 0;
     // {min_disparity, num_disparities}
     virtual std::pair<int32_t, int32_t> disparityRange() const { return {0, 0}; }
+    // Named planes attached to the last compute's disparity (matcher.h: extras), each of
+    // its size, e.g. {"disparity_filled", a GRAY8 view}: names and pixels the matcher
+    // keeps until its next compute. None by default.
+    virtual std::vector<binocle_named_image> extras() { return {}; }
 };
 
 class CloudTransform {
@@ -347,6 +351,13 @@ template <class T, class Handle>
 Instance<T> &inst(Handle *h) {
     return *reinterpret_cast<Instance<T> *>(h);
 }
+
+// Matcher instances keep the list of extras they last handed out.
+template <class T>
+struct MatcherInstance : Instance<T> {
+    using Instance<T>::Instance;
+    std::vector<binocle_named_image> extras;
+};
 
 // Source instances also keep the frames they have lent.
 template <class T>
@@ -470,6 +481,17 @@ binocle_result matcherCompute(binocle_matcher *h, const binocle_image *l, const 
 }
 
 template <class T>
+binocle_result matcherExtras(binocle_matcher *h, const binocle_named_image **extras, int32_t *count) noexcept {
+    auto &s = *reinterpret_cast<MatcherInstance<T> *>(h);
+    return guard(s.error, [&] {
+        if (!extras || !count) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "extras: NULL argument");
+        s.extras = s.impl->extras();
+        *extras = s.extras.empty() ? nullptr : s.extras.data();
+        *count = static_cast<int32_t>(s.extras.size());
+    });
+}
+
+template <class T>
 binocle_result matcherRange(binocle_matcher *h, int32_t *mn, int32_t *num) noexcept {
     auto &s = inst<T>(h);
     return guard(s.error, [&] {
@@ -550,10 +572,11 @@ const binocle_source_api *sourceTable(const char *name, const char *version, con
 
 template <class T>
 const binocle_matcher_api *matcherTable(const char *name, const char *version, const char *description) {
-    return onceTable<binocle_matcher_api, T, Instance<T>, binocle_matcher>(
+    return onceTable<binocle_matcher_api, T, MatcherInstance<T>, binocle_matcher>(
         BINOCLE_KIND_MATCHER, name, version, description, [](binocle_matcher_api &t) {
             t.compute = &matcherCompute<T>;
             t.disparity_range = &matcherRange<T>;
+            t.extras = &matcherExtras<T>;
         });
 }
 

@@ -35,6 +35,11 @@ typedef struct binocle_eval_input {
                                   cloud_transform.h); 0: the two below mean nothing    */
     double camera_height_mm;   /* hc: the left optical centre above the ground          */
     double inclination_deg;    /* theta: downward pitch of the optical axis            */
+    /* The planes the matcher attached to this frame's disparity (matcher.h: extras), e.g.
+       "disparity_filled" (GRAY8, non-zero = filled in, not matched); NULL and 0 when it
+       attached none. Each of the disparity's size. */
+    const binocle_named_image *disparity_extras;
+    int32_t disparity_extra_count;
 } binocle_eval_input;
 
 /* True when the host's binocle_eval_input holds `member` (an entry appended after API 1). */

@@ -31,7 +31,21 @@ typedef struct binocle_matcher_api {
     /* The disparity search window: min_disparity .. min_disparity + num_disparities - 1. */
     binocle_result (*disparity_range)(binocle_matcher *matcher, int32_t *min_disparity,
                                       int32_t *num_disparities);
+
+    /* Appended after API 1: a host reads it only when header.struct_size reaches it, and a
+       plugin may leave it NULL (no extras). The named planes the matcher attached to the
+       disparity of its last successful compute, each of the disparity's size (GRAY8,
+       GRAY16 or FLOAT32), e.g. "disparity_filled" (GRAY8, non-zero = the value was filled
+       in, not matched). *extras: *count entries, names and pixels owned by the matcher,
+       valid until its next compute or destroy. The host copies them and hands them to
+       evaluators (binocle_eval_input.disparity_extras). */
+    binocle_result (*extras)(binocle_matcher *matcher, const binocle_named_image **extras,
+                             int32_t *count);
 } binocle_matcher_api;
+
+/* True when a matcher table holds `member` (an entry appended after API 1). */
+#define BINOCLE_MATCHER_API_HAS(api, member)                                                   \
+    ((api).header.struct_size >= offsetof(binocle_matcher_api, member) + sizeof((api).member))
 
 #ifdef __cplusplus
 }

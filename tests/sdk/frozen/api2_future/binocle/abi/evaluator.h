@@ -35,6 +35,9 @@ typedef struct binocle_eval_input {
                                   cloud_transform.h); 0: the two below mean nothing    */
     double camera_height_mm;   /* hc: the left optical centre above the ground          */
     double inclination_deg;    /* theta: downward pitch of the optical axis            */
+    /* The planes the matcher attached to this frame's disparity (as today's evaluator.h). */
+    const binocle_named_image *disparity_extras;
+    int32_t disparity_extra_count;
 } binocle_eval_input;
 
 /* True when the host's binocle_eval_input holds `member` (an entry appended after API 1). */

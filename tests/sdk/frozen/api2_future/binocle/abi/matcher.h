@@ -32,6 +32,10 @@ typedef struct binocle_matcher_api {
     binocle_result (*disparity_range)(binocle_matcher *matcher, int32_t *min_disparity,
                                       int32_t *num_disparities);
 
+    /* Appended after API 1, as today's matcher.h has it (see there). */
+    binocle_result (*extras)(binocle_matcher *matcher, const binocle_named_image **extras,
+                             int32_t *count);
+
     /* ---- API 2 (a test's idea of the next API: appended, never inserted) ---- */
     /* One line on how the matcher is tuned, valid until the next call. */
     binocle_result (*describe)(binocle_matcher *matcher, const char **text);
