@@ -13,6 +13,7 @@
 #include "bench_plugins.hpp"
 #include "config/rig_config.hpp"
 #include "host/plugin_host.hpp"
+#include "input/image_file.hpp"
 
 #include <benchmark/benchmark.h>
 #include <nlohmann/json.hpp>
@@ -40,29 +41,6 @@ fs::path stereoGtDir() {
     return fs::path(BINOCLE_SOURCE_DIR) / ".." / "shared" / "data" / "stereo-gt";
 }
 
-// A PFM of one channel ("Pf"): the scale's sign gives the byte order (negative: little
-// endian), its magnitude is not applied (Middlebury writes -1/255 and means the floats);
-// rows are stored bottom to top.
-cv::Mat readPfm(const fs::path &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::string magic;
-    int width = 0, height = 0;
-    double scale = 0;
-    in >> magic >> width >> height >> scale;
-    in.get(); // the one whitespace character after the scale
-    if (!in || magic != "Pf" || width <= 0 || height <= 0 || scale == 0)
-        throw std::runtime_error(path.string() + ": expected a one-channel PFM (Pf, width, height, scale != 0)");
-    cv::Mat m(height, width, CV_32FC1);
-    for (int y = height - 1; y >= 0; --y) in.read(m.ptr<char>(y), static_cast<std::streamsize>(width) * 4);
-    if (!in) throw std::runtime_error(path.string() + ": shorter than " + std::to_string(width) + "x" + std::to_string(height) + " floats");
-    if (scale > 0) // big endian
-        for (int y = 0; y < height; ++y) {
-            auto *p = m.ptr<uint32_t>(y);
-            for (int x = 0; x < width; ++x) p[x] = __builtin_bswap32(p[x]);
-        }
-    return m;
-}
-
 struct Pair {
     std::string name;
     cv::Mat left, right;
@@ -80,7 +58,7 @@ Pair loadPair(const fs::path &root, const nlohmann::json &entry) {
     const std::string format = entry.at("gt_format").get<std::string>();
     const fs::path gt = dir / entry.at("gt").get<std::string>();
     if (format == "pfm") {
-        p.truth = readPfm(gt);
+        p.truth = binocle::input::readPfm(gt.string(), "ground truth"); // the scale's sign only (docs/benchmarks.md)
     } else {
         const cv::Mat raw = cv::imread(gt.string(), format == "png16" ? cv::IMREAD_UNCHANGED : cv::IMREAD_GRAYSCALE);
         if (raw.empty()) throw std::runtime_error(gt.string() + ": cannot be read");

@@ -19,10 +19,14 @@ namespace {
 using binocle::sdk::Error;
 using binocle::sdk::Param;
 
-const binocle_image *findExtra(const binocle_stereo_frame &f, const char *name) {
-    for (int32_t i = 0; i < f.extra_count; ++i)
-        if (f.extras[i].name && std::strcmp(f.extras[i].name, name) == 0) return &f.extras[i].image;
+const binocle_image *findPlane(const binocle_named_image *planes, int32_t count, const char *name) {
+    for (int32_t i = 0; planes && i < count; ++i)
+        if (planes[i].name && std::strcmp(planes[i].name, name) == 0) return &planes[i].image;
     return nullptr;
+}
+
+const binocle_image *findExtra(const binocle_stereo_frame &f, const char *name) {
+    return findPlane(f.extras, f.extra_count, name);
 }
 
 template <class T>
@@ -39,8 +43,10 @@ struct Tally {
     std::vector<double> bad; // per threshold: matched with |d - gt| > t, plus every hole
     double sum_abs = 0, sum_sq = 0; // over matched pixels
     double d1 = 0;       // KITTI: |e| > 3 px and |e| > 5 % of gt, on the hole-filled map
+    double filled = 0;   // of the matched, those the matcher marked as filled in (disparity_filled)
     void add(const Tally &o) {
         n += o.n;
+        filled += o.filled;
         invalid += o.invalid;
         bad.resize(o.bad.size(), 0);
         for (size_t i = 0; i < o.bad.size(); ++i) bad[i] += o.bad[i];
@@ -53,6 +59,7 @@ struct Tally {
 struct Frame {
     Tally all, nonocc;
     bool hasNonocc = false;
+    bool hasFilled = false; // the matcher attached a disparity_filled plane
 };
 
 // The KITTI devkit's interpolateBackground (devkit_stereo_flow, io_disp.h): each run of
@@ -182,11 +189,17 @@ public:
                         "disparity evaluator: gt_disparity is " + std::to_string(gt->width) + "x" + std::to_string(gt->height) +
                             " (format " + std::to_string(gt->format) + "), the disparity map " + std::to_string(d.width) + "x" +
                             std::to_string(d.height) + ": expected the same size, both FLOAT32");
-        const Frame f = score(*in.frame, *gt, d);
+        const binocle_image *filledPlane =
+            BINOCLE_EVAL_INPUT_HAS(in, disparity_extra_count)
+                ? checkedPlane(findPlane(in.disparity_extras, in.disparity_extra_count, "disparity_filled"),
+                               "the matcher's disparity_filled", d)
+                : nullptr;
+        const Frame f = score(*in.frame, *gt, d, filledPlane);
         report(f);
         total_.all.add(f.all);
         total_.nonocc.add(f.nonocc);
         total_.hasNonocc = total_.hasNonocc || f.hasNonocc;
+        total_.hasFilled = total_.hasFilled || f.hasFilled;
         ++frames_;
     }
 
@@ -198,21 +211,26 @@ public:
 
 private:
     const binocle_image *mask(const binocle_stereo_frame &frame, const char *name, const binocle_image &d) const {
-        const binocle_image *m = findExtra(frame, name);
+        return checkedPlane(findExtra(frame, name), name, d);
+    }
+
+    static const binocle_image *checkedPlane(const binocle_image *m, const std::string &name, const binocle_image &d) {
         if (m && (m->format != BINOCLE_PIXEL_GRAY8 || m->width != d.width || m->height != d.height))
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, std::string("disparity evaluator: ") + name + " is " +
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "disparity evaluator: " + name + " is " +
                                                           std::to_string(m->width) + "x" + std::to_string(m->height) +
                                                           " (format " + std::to_string(m->format) +
                                                           "): expected GRAY8 of the disparity map's size");
         return m;
     }
 
-    Frame score(const binocle_stereo_frame &frame, const binocle_image &gt, const binocle_image &d) const {
+    Frame score(const binocle_stereo_frame &frame, const binocle_image &gt, const binocle_image &d,
+                const binocle_image *filledPlane) const {
         const binocle_image *valid = mask(frame, "gt_valid", d);
         const binocle_image *nonocc = mask(frame, "gt_nonocc", d);
         const std::vector<float> filled = backgroundFilled(d);
         Frame f;
         f.hasNonocc = nonocc != nullptr;
+        f.hasFilled = filledPlane != nullptr;
         f.all.bad.assign(thresholds_.size(), 0);
         f.nonocc.bad.assign(thresholds_.size(), 0);
         for (int v = 0; v < d.height; ++v)
@@ -241,6 +259,7 @@ private:
                         for (double &b : t->bad) b += 1;
                         continue;
                     }
+                    if (filledPlane && at<uint8_t>(*filledPlane, u, v) != 0) t->filled += 1;
                     const double e = std::fabs(static_cast<double>(x) - g);
                     t->sum_abs += e;
                     t->sum_sq += e * e;
@@ -268,6 +287,13 @@ private:
     void report(const Frame &f) {
         if (f.hasNonocc) reportRegion(f.nonocc, "nonocc", "noc");
         reportRegion(f.all, "all", "all");
+        // The share of the scored pixels whose disparity the matcher filled in rather than
+        // matched (its disparity_filled plane: sgm's fill: dense), so that a dense matcher's
+        // figures can be told from a sparse one's.
+        if (f.hasFilled) {
+            if (f.hasNonocc) host_.metric("filled_nonocc_percent", f.nonocc.n > 0 ? 100.0 * f.nonocc.filled / f.nonocc.n : NAN, "%");
+            host_.metric("filled_all_percent", f.all.n > 0 ? 100.0 * f.all.filled / f.all.n : NAN, "%");
+        }
         host_.metric("density_percent", f.all.n > 0 ? 100.0 * (f.all.n - f.all.invalid) / f.all.n : NAN, "%");
         host_.metric("ground_truth_pixels", f.all.n);
         if (f.hasNonocc) host_.metric("nonocc_pixels", f.nonocc.n);

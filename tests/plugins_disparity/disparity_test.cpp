@@ -134,6 +134,37 @@ TEST(DisparityEvaluator, WithoutGtNonoccTheNonoccFiguresAreAbsent) {
     EXPECT_NEAR(run.metrics.at("bad_3px_all_percent"), 100.0 * (3 + 3) / 15, 1e-9); // 3.5 5.0 4.5 and the holes
 }
 
+// A matcher's disparity_filled plane (sgm's fill: dense): the share of the scored pixels
+// whose value was filled in, not matched. Marked: row 0 columns 0 and 4 (matched, known;
+// column 4 occluded), row 1 column 0 (no ground truth: not scored), row 1 column 6 (a hole:
+// not a filled value).
+TEST(DisparityEvaluator, TheMatchersFilledPixelsAreCounted) {
+    EvalRun run;
+    Frame frame(true);
+    std::vector<uint8_t> filled(16, 0);
+    filled[0] = filled[4] = filled[8] = filled[14] = 255;
+    binocle_named_image plane{"disparity_filled", Frame::image(filled.data(), BINOCLE_PIXEL_GRAY8, 8)};
+    frame.in.disparity_extras = &plane;
+    frame.in.disparity_extra_count = 1;
+    run.evaluator->evaluate(frame.in);
+    EXPECT_NEAR(run.metrics.at("filled_all_percent"), 100.0 * 2 / 15, 1e-9);
+    EXPECT_NEAR(run.metrics.at("filled_nonocc_percent"), 100.0 * 1 / 13, 1e-9);
+    // Without the plane (a sparse matcher, or a host of API 1) the figures are absent.
+    EvalRun sparse;
+    Frame plain(true);
+    sparse.evaluator->evaluate(plain.in);
+    EXPECT_EQ(sparse.metrics.count("filled_all_percent"), 0u);
+    // A plane of another size or format is refused, naming it.
+    std::vector<float> wrong(16, 0);
+    plane.image = Frame::image(wrong.data(), BINOCLE_PIXEL_FLOAT32, 32);
+    try {
+        run.evaluator->evaluate(frame.in);
+        FAIL() << "a FLOAT32 disparity_filled plane was accepted";
+    } catch (const std::exception &e) {
+        EXPECT_NE(std::string(e.what()).find("disparity_filled"), std::string::npos) << e.what();
+    }
+}
+
 TEST(DisparityEvaluator, AGroundTruthBeyondTheWidthOrBadThresholdsAreRefused) {
     EvalRun run;
     Frame frame(true, 255.0f); // what a PFM read by its -1/255 scale's magnitude gives
