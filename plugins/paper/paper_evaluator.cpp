@@ -102,6 +102,19 @@ public:
                 .help("the panel's band is looked for within the true range +- this"),
             Param::real("lateral_margin_mm", "0").min(0).unit("mm")
                 .help("> 0: read the panel only within its true lateral span +- this; 0: the whole grid"),
+            Param::choice("reading", "region", "region|band")
+                .help("region: the dense cells connected to the panel's stated position (a person's reading); "
+                      "band: every occupied cell of the range band (the reading before issue 33)"),
+            Param::real("panel_true_center_x_mm", "0").unit("mm")
+                .help("the panel's lateral middle (rough is enough); unset: the frame metadata's panel, else 0"),
+            Param::real("seed_half_width_mm", "1000").min(1).unit("mm")
+                .help("region reading: the panel has points within this of its stated lateral middle"),
+            Param::real("relative_density", "0.5").min(0).max(1)
+                .help("region reading: the panel's cells hold at least this share of its typical cell"),
+            Param::real("bridge_mm", "500").min(0).unit("mm")
+                .help("region reading: gaps inside the panel up to this wide are bridged"),
+            Param::real("max_width_ratio", "2").min(1.01)
+                .help("region reading: a region wider than this times the true width is not separated (rejected)"),
             Param::integer("min_panel_points", "50").min(1).help("fewer panel points: not registered (rejected)"),
             Param::boolean("write_views", false)
                 .help("write the top, front and side density views as PNG into the output folder"),
@@ -236,13 +249,11 @@ private:
                         "paper: no true panel size for Eq. 2-4 (missing:" + missing +
                             "): set them in the evaluator's YAML (tape-measured), or use a source whose frame metadata "
                             "has a `panel:` entry (sim)");
-        const double centerX = truth.panel_center_x_mm.value_or(0.0);
-        method::PanelReadingOptions o;
-        o.grid = grid_;
+        const double centerX = given("panel_true_center_x_mm", truth.panel_center_x_mm.value_or(0.0));
+        method::PanelReadingOptions o = readingOptions();
         o.expected_range_mm = trueSize.range_mm;
-        o.range_search_percent = p_.real("range_search_percent");
-        o.range_margin_mm = p_.real("range_margin_mm");
-        o.min_points = p_.integer("min_panel_points");
+        o.expected_x_mm = centerX;
+        o.expected_width_mm = trueSize.width_mm;
         if (p_.real("lateral_margin_mm") > 0) {
             const double half = trueSize.width_mm / 2 + p_.real("lateral_margin_mm");
             o.lateral = {centerX - half, centerX + half};
@@ -266,13 +277,9 @@ private:
         metric("true_height_mm", trueSize.height_mm, "mm");
         metric("panel_points", static_cast<double>(r.points));
         metric("panel_ground_z_mm", r.ground_z_mm, "mm");
-        if (r.registered) {
-            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
-                                      "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Z' " + fixed(r.height_mm / 1000, 2) + " m",
-                                      {40, 40, 220}});
-            drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m",
-                                     {40, 40, 220}});
-        }
+        metric("panel_cell_threshold", r.cell_threshold);
+        metric("panel_band_depth_mm", r.band.valid() ? r.band.size() : kNaN, "mm");
+        drawReading(r, drawings);
         placement = method::PanelPlacement{trueSize.width_mm, trueSize.height_mm, centerX,
                                            truth.panel_base_z_mm.value_or(0.0)};
         return trueSize.range_mm;
@@ -303,11 +310,7 @@ private:
                         "paper (experiment e2): no known object" + (name.empty() ? std::string() : " named '" + name + "'") +
                             " in the frame metadata: set `object` to the name of one of its objects, or "
                             "object_center_mm and object_size_mm");
-        method::PanelReadingOptions o;
-        o.grid = grid_;
-        o.range_search_percent = p_.real("range_search_percent");
-        o.range_margin_mm = p_.real("range_margin_mm");
-        o.min_points = p_.integer("min_panel_points");
+        const method::PanelReadingOptions o = readingOptions();
         const method::ObjectOffset off = method::locateKnownObject(cloud, known, o, p_.real("object_margin_mm"));
         if (!off.found)
             host_.warning("frame " + std::to_string(sequence_) + ": known object '" + known.name +
@@ -342,6 +345,42 @@ private:
         metric("inclination_true_deg", trueInclination, "deg");
         metric("angular_error_deg", recovered - trueInclination, "deg");
         return off.true_range_mm;
+    }
+
+    // How the panel (e1) or the known object (e2) is read, from the settings.
+    method::PanelReadingOptions readingOptions() const {
+        method::PanelReadingOptions o;
+        o.grid = grid_;
+        o.range_search_percent = p_.real("range_search_percent");
+        o.range_margin_mm = p_.real("range_margin_mm");
+        o.min_points = p_.integer("min_panel_points");
+        o.method = p_.string("reading") == "band" ? method::PanelReadingMethod::Band : method::PanelReadingMethod::Region;
+        o.seed_half_width_mm = p_.real("seed_half_width_mm");
+        o.relative_density = p_.real("relative_density");
+        o.bridge_mm = p_.real("bridge_mm");
+        o.max_width_ratio = p_.real("max_width_ratio");
+        return o;
+    }
+
+    // What the reading took, drawn over the views: the outline of the panel's cells in
+    // the front (X, Z) and top (X, Y) views, its box and X', Y', Z' (README: the report
+    // and `binocle view` show them, so that a person can check each figure by eye).
+    void drawReading(const method::PanelReading &r, Drawings &drawings) const {
+        const cv::Scalar red{40, 40, 220};
+        const double cell = grid_.cell_mm;
+        if (!r.registered) {
+            if (r.front_cells.empty()) return;
+            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm}, "not separated", red,
+                                      r.front_cells, cell});
+            return;
+        }
+        drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
+                                  "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Z' " + fixed(r.height_mm / 1000, 2) + " m",
+                                  red, r.front_cells, cell});
+        drawings.top.push_back({{r.x_min_mm, r.x_max_mm}, r.band,
+                                "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Y' " + fixed(r.range_mm / 1000, 2) + " m",
+                                red, r.top_cells, cell});
+        drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m", red});
     }
 
     // Eq. 7 and the sensor-aware figures, when B, f and p are known.
@@ -395,11 +434,17 @@ private:
         nlohmann::ordered_json j = nlohmann::ordered_json::object();
         auto list = [](const std::vector<method::ViewOverlay> &v) {
             nlohmann::ordered_json a = nlohmann::ordered_json::array();
-            for (const method::ViewOverlay &o : v)
+            for (const method::ViewOverlay &o : v) {
                 a.push_back({{"u_mm", {o.u.min_mm, o.u.max_mm}},
                              {"v_mm", {o.v.min_mm, o.v.max_mm}},
                              {"label", o.label},
                              {"bgr", {o.color[0], o.color[1], o.color[2]}}});
+                if (o.cells.empty()) continue;
+                nlohmann::ordered_json cells = nlohmann::ordered_json::array();
+                for (const auto &c : o.cells) cells.push_back({c[0], c[1]});
+                a.back()["cell_mm"] = o.cell_mm;
+                a.back()["cells_mm"] = std::move(cells);
+            }
             return a;
         };
         j["top"] = list(d.top);
