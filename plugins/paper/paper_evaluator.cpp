@@ -10,6 +10,7 @@
 #include "method/ground_plane.hpp"
 #include "method/panel.hpp"
 #include "method/relative_errors.hpp"
+#include "paper/oracle_cloud.hpp"
 #include "paper/rig_facts.hpp"
 
 #include <binocle/plugin.hpp>
@@ -113,6 +114,8 @@ public:
                 .help("region reading: the panel's cells hold at least this share of its typical cell"),
             Param::real("bridge_mm", "500").min(0).unit("mm")
                 .help("region reading: gaps inside the panel up to this wide are bridged"),
+            Param::boolean("oracle", true)
+                .help("e1: read the panel also on the cloud of the frame's gt_disparity (the sim's): *_oracle_* figures"),
             Param::real("max_width_ratio", "2").min(1.01)
                 .help("region reading: a region wider than this times the true width is not separated (rejected)"),
             Param::integer("min_panel_points", "50").min(1).help("fewer panel points: not registered (rejected)"),
@@ -172,6 +175,7 @@ public:
         const std::string calibrationText = in.calibration_yaml ? in.calibration_yaml : "";
         if (!calibrationParsed_ || calibrationText != calibrationText_) {
             calibration_ = paper::parseCalibrationFacts(in.calibration_yaml);
+            oracle_.setCalibration(calibrationText);
             calibrationText_ = calibrationText;
             calibrationParsed_ = true;
         }
@@ -191,7 +195,7 @@ public:
         double range = kNaN;
         std::optional<method::PanelPlacement> panel;
         if (e2_) range = evaluateE2(cloud, truth, drawings);
-        else range = evaluatePanel(cloud, truth, drawings, panel);
+        else range = evaluatePanel(cloud, truth, drawings, panel, in.frame);
         reportDesign(truth, range, panel ? &*panel : nullptr);
         host_.text("view_overlays", overlaysJson(drawings));
         if (p_.boolean("write_views")) writeViews(cloud, in.output_dir, drawings);
@@ -236,7 +240,7 @@ private:
     }
 
     double evaluatePanel(const method::CloudView &cloud, const paper::FrameTruth &truth, Drawings &drawings,
-                         std::optional<method::PanelPlacement> &placement) {
+                         std::optional<method::PanelPlacement> &placement, const binocle_stereo_frame *frame) {
         const method::PanelSize trueSize{given("panel_true_width_mm", truth.panel_width_mm),
                                          given("panel_true_range_mm", truth.panel_range_mm),
                                          given("panel_true_height_mm", truth.panel_height_mm)};
@@ -280,6 +284,7 @@ private:
         metric("panel_cell_threshold", r.cell_threshold);
         metric("panel_band_depth_mm", r.band.valid() ? r.band.size() : kNaN, "mm");
         drawReading(r, drawings);
+        if (p_.boolean("oracle")) scoreOracle(frame, o, trueSize, s);
         placement = method::PanelPlacement{trueSize.width_mm, trueSize.height_mm, centerX,
                                            truth.panel_base_z_mm.value_or(0.0)};
         return trueSize.range_mm;
@@ -345,6 +350,27 @@ private:
         metric("inclination_true_deg", trueInclination, "deg");
         metric("angular_error_deg", recovered - trueInclination, "deg");
         return off.true_range_mm;
+    }
+
+    // The same reading on the cloud of the ground-truth disparity (oracle_cloud.hpp): what
+    // the camera configuration alone allows; the difference is what the matcher costs.
+    // Nothing is reported when the frame carries no gt_disparity.
+    void scoreOracle(const binocle_stereo_frame *frame, const method::PanelReadingOptions &o,
+                     const method::PanelSize &trueSize, const method::PanelScore &measured) {
+        const auto cloud = oracle_.groundCloud(frame, rig_.applied_camera_height_mm, rig_.applied_inclination_deg);
+        if (!cloud) return;
+        const method::PanelReading r = method::readPanel(method::CloudView(*cloud), o);
+        const method::PanelScore s = method::scorePanel(r.size(), trueSize, r.registered);
+        if (!r.registered)
+            host_.warning("frame " + std::to_string(sequence_) + ": panel not registered on the ground-truth cloud (oracle): " + r.reason);
+        metric("registered_oracle", r.registered ? 1 : 0);
+        metric("epsilon_x_oracle_percent", s.epsilon_x_percent, "%");
+        metric("epsilon_y_oracle_percent", s.epsilon_y_percent, "%");
+        metric("epsilon_z_oracle_percent", s.epsilon_z_percent, "%");
+        metric("eta_2d_oracle_percent", s.eta_2d_percent, "%");
+        metric("eta_3d_oracle_percent", s.eta_3d_percent, "%");
+        metric("measured_width_oracle_mm", r.width_mm, "mm");
+        metric("eta_3d_matcher_loss_percent", s.eta_3d_percent - measured.eta_3d_percent, "%");
     }
 
     // How the panel (e1) or the known object (e2) is read, from the settings.
@@ -500,6 +526,7 @@ private:
     bool e2_ = false;
     method::GridSpec grid_;
     std::optional<std::vector<double>> objectCenter_, objectSize_;
+    paper::OracleProjector oracle_;
     paper::RigFacts calibration_, rig_; // the calibration's facts; with the host's of this frame
     std::string calibrationText_;
     bool calibrationParsed_ = false;
