@@ -263,6 +263,33 @@ struct ImageProblems {
     std::vector<std::string> missing, unreadable; // "test_3: top view (XY)", "test_3/paper_top_000000.png"
 };
 
+// The value of the first column named "<evaluator>.<figure>" (whichever evaluator
+// reported it), or null.
+OJson figureOf(const OJson &row, const std::string &figure) {
+    for (const auto &[k, v] : row.items())
+        if (k.size() > figure.size() + 1 && k.compare(k.size() - figure.size() - 1, std::string::npos, "." + figure) == 0)
+            return v;
+    return OJson();
+}
+
+// What the reading took as the panel, in words beside the views that outline it.
+std::string readingLine(const OJson &row) {
+    const OJson x = figureOf(row, "measured_width_mm"), y = figureOf(row, "measured_range_mm"),
+                z = figureOf(row, "measured_height_mm");
+    if (x.is_null() && y.is_null() && z.is_null()) return "";
+    auto metres = [](const OJson &v) { return v.is_number() ? number(OJson(v.get<double>() / 1000), 2) + " m" : std::string("–"); };
+    std::ostringstream os;
+    os << "<p class=\"reading\">Read as the panel (outlined in red in the front and top views): X′ = " << metres(x)
+       << ", Y′ = " << metres(y) << ", Z′ = " << metres(z);
+    const OJson xo = figureOf(row, "measured_width_oracle_mm");
+    if (xo.is_number()) os << "; on the ground-truth disparity X′ = " << metres(xo);
+    const OJson reg = figureOf(row, "registered");
+    if (reg.is_number() && reg.get<double>() < 1)
+        os << " · registered in " << number(OJson(100 * reg.get<double>()), 0) << " % of the frames";
+    os << "</p>";
+    return os.str();
+}
+
 std::string testSections(const fs::path &dir, const OJson &results, ImageProblems &problems) {
     std::ostringstream os;
     for (const auto &row : results["tests"]) {
@@ -275,7 +302,7 @@ std::string testSections(const fs::path &dir, const OJson &results, ImageProblem
                << "</span> ";
         }
         if (row.contains("error")) os << "<span class=\"failed\">" << escape(row["error"].get<std::string>()) << "</span>";
-        os << "</p><div class=\"images\">";
+        os << "</p>" << readingLine(row) << "<div class=\"images\">";
         struct Item {
             const char *prefix, *label;
         };
