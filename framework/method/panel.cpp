@@ -114,6 +114,38 @@ std::vector<std::array<float, 2>> cellsOf(const std::vector<float> &u, const std
                            static_cast<float>(static_cast<double>(c.second) * cell)});
     return out;
 }
+// Step 2 of the region reading: keeps, of the band's points, the panel's region
+// (panel_region.hpp); false with r.reason when there is none.
+bool keepPanelRegion(const PanelReadingOptions &o, std::vector<float> &px, std::vector<float> &py,
+                     std::vector<float> &pz, PanelReading &r) {
+    const GridSpec &g = o.grid;
+    PanelRegionOptions ro;
+    ro.cell_mm = g.cell_mm;
+    ro.density_threshold = g.density_threshold;
+    ro.min_cells = g.min_object_cells;
+    ro.seed_x_mm = o.expected_x_mm;
+    ro.seed_half_width_mm = o.seed_half_width_mm;
+    ro.relative_density = o.relative_density;
+    ro.bridge_mm = o.bridge_mm;
+    const PanelRegion found = selectPanelRegion(px, pz, ro);
+    if (!found.found) {
+        r.reason = "no panel: " + found.reason + " in the range band " + mm(r.band.min_mm) + " .. " + mm(r.band.max_mm);
+        return false;
+    }
+    r.cell_threshold = found.threshold;
+    size_t k = 0;
+    for (size_t i = 0; i < px.size(); ++i)
+        if (found.members[i]) {
+            px[k] = px[i];
+            py[k] = py[i];
+            pz[k] = pz[i];
+            ++k;
+        }
+    px.resize(k);
+    py.resize(k);
+    pz.resize(k);
+    return true;
+}
 } // namespace
 
 PanelReading readPanel(const CloudView &cloud, const PanelReadingOptions &o) {
@@ -151,33 +183,7 @@ PanelReading readPanel(const CloudView &cloud, const PanelReadingOptions &o) {
         pz.push_back(cloud.z(i));
     }
     r.cell_threshold = g.density_threshold;
-    if (region) {
-        PanelRegionOptions ro;
-        ro.cell_mm = g.cell_mm;
-        ro.density_threshold = g.density_threshold;
-        ro.min_cells = g.min_object_cells;
-        ro.seed_x_mm = o.expected_x_mm;
-        ro.seed_half_width_mm = o.seed_half_width_mm;
-        ro.relative_density = o.relative_density;
-        ro.bridge_mm = o.bridge_mm;
-        const PanelRegion found = selectPanelRegion(px, pz, ro);
-        if (!found.found) {
-            r.reason = "no panel: " + found.reason + " in the range band " + mm(r.band.min_mm) + " .. " + mm(r.band.max_mm);
-            return r;
-        }
-        r.cell_threshold = found.threshold;
-        size_t k = 0;
-        for (size_t i = 0; i < px.size(); ++i)
-            if (found.members[i]) {
-                px[k] = px[i];
-                py[k] = py[i];
-                pz[k] = pz[i];
-                ++k;
-            }
-        px.resize(k);
-        py.resize(k);
-        pz.resize(k);
-    }
+    if (region && !keepPanelRegion(o, px, py, pz, r)) return r;
     const PlanarExtent front = planarExtent(px, pz, g.cell_mm, r.cell_threshold, g.min_object_cells);
     if (!front.found || front.member_count < o.min_points) {
         r.reason = "no panel: " + std::to_string(front.member_count) + " points in occupied front-view cells (" +
