@@ -163,6 +163,7 @@ ObjectOffset locateKnownObject(const CloudView &cloud, const KnownObject &truth,
     const PanelReading r = readPanel(cloud, options);
     if (!r.registered) return off;
     off.found = true;
+    off.reading = r;
     off.measured_x_mm = (r.x_min_mm + r.x_max_mm) / 2;
     off.measured_range_mm = r.range_mm;
     off.lateral_mm = off.measured_x_mm - off.true_x_mm;

@@ -327,10 +327,16 @@ private:
         metric("true_range_mm", off.true_range_mm, "mm");
         metric("object_offset_lateral_mm", off.found ? off.lateral_mm : kNaN, "mm");
         metric("object_offset_range_mm", off.found ? off.range_mm : kNaN, "mm");
-        if (off.found)
-            drawings.top.push_back({{off.measured_x_mm - known.size_mm[0] / 2, off.measured_x_mm + known.size_mm[0] / 2},
+        if (off.found) { // what was read as the known object, outlined (README: the views)
+            const method::PanelReading &r = off.reading;
+            drawings.top.push_back({{r.x_min_mm, r.x_max_mm},
                                     {off.measured_range_mm, off.measured_range_mm + known.size_mm[1]},
-                                    known.name, {40, 40, 220}});
+                                    known.name + " Y' " + fixed(off.measured_range_mm / 1000, 2) + " m",
+                                    {40, 40, 220}, r.top_cells, grid_.cell_mm});
+            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
+                                      known.name + " X " + fixed(off.measured_x_mm / 1000, 2) + " m",
+                                      {40, 40, 220}, r.front_cells, grid_.cell_mm});
+        }
 
         // The ground plane, and the inclination it gives back (Eq. 1 applied with the
         // ground transform's inclination).

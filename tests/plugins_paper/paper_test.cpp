@@ -396,6 +396,10 @@ objects:
     run.evaluator->evaluate(input.get());
     EXPECT_EQ(run["registered"], 1);
     EXPECT_NEAR(run["object_offset_lateral_mm"], -40, 10);
+    // The cells read as the marker are outlined in the front view too.
+    const nlohmann::json overlays = nlohmann::json::parse(run.texts.at("view_overlays"));
+    ASSERT_FALSE(overlays["front"].empty()) << overlays.dump();
+    EXPECT_FALSE(overlays["front"][0]["cells_mm"].empty()) << overlays.dump();
     EXPECT_NEAR(run["object_offset_range_mm"], 0, 5);
     EXPECT_LT(run["epsilon_y_percent"], 0.1);
     EXPECT_EQ(run["inclination_applied_deg"], 5.5);
