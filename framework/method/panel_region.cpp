@@ -29,6 +29,7 @@ cv::Mat denseCells(const cv::Mat &counts, int threshold, int min_cells) {
         if (stats.at<int>(l, cv::CC_STAT_AREA) < min_cells) dense.setTo(0, labels == l);
     return dense;
 }
+
 // Median of a list of cell indices, rounded outwards (up for an upper edge).
 int medianCell(std::vector<float> v, bool upper) {
     const double m = median(std::move(v));
