@@ -544,6 +544,7 @@ private:
 
 } // namespace
 
-BINOCLE_EXPORT_EVALUATOR(PaperEvaluator, "paper", "1.0.0",
-                         "METHOD.md: E1 panel relative errors and efficiencies (Eq. 2-6), E2 ground and object "
-                         "indicators, form factor (Eq. 7), density-grid views and objects")
+BINOCLE_EXPORT_EVALUATOR(PaperEvaluator, "paper", "1.1.0",
+                         "METHOD.md: E1 panel relative errors and efficiencies (Eq. 2-6) read as a person reads the "
+                         "views, with the ground-truth oracle; E2 ground and object indicators, form factor (Eq. 7), "
+                         "density-grid views and objects")
