@@ -128,7 +128,20 @@ cv::Mat renderDensityView(const DensityView &view, const RenderOptions &options)
 
     for (const ViewOverlay &o : options.overlays) {
         const cv::Point a(px(o.u.min_mm), py(o.v.max_mm)), b(px(o.u.max_mm), py(o.v.min_mm));
-        cv::rectangle(img, a, b, o.color, 2, cv::LINE_AA);
+        if (!o.cells.empty() && o.cell_mm > 0) {
+            // The outline of the cells the reading took, over the counts it read them from.
+            cv::Mat mask = cv::Mat::zeros(img.size(), CV_8U);
+            for (const auto &c : o.cells)
+                cv::rectangle(mask, cv::Point(px(c[0]), py(c[1] + o.cell_mm)), cv::Point(px(c[0] + o.cell_mm) - 1, py(c[1]) - 1),
+                              255, cv::FILLED);
+            mask(cv::Rect(0, 0, img.cols, top)).setTo(0);
+            std::vector<std::vector<cv::Point>> contours;
+            cv::findContours(mask, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
+            cv::drawContours(img, contours, -1, o.color, 1, cv::LINE_8);
+            cv::rectangle(img, a, b, o.color, 1, cv::LINE_AA);
+        } else {
+            cv::rectangle(img, a, b, o.color, 2, cv::LINE_AA);
+        }
         if (!o.label.empty()) {
             const cv::Point at(std::clamp(a.x, left, left + W - 10), std::max(a.y - 5, top + 12));
             text(img, o.label, at, 0.42, o.color, 1);

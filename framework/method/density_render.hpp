@@ -7,16 +7,20 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <string>
 #include <vector>
 
 namespace binocle::method {
 
-// A box drawn over a view, in the view's (u, v) millimetres, e.g. a localised object.
+// A box drawn over a view, in the view's (u, v) millimetres, e.g. a localised object;
+// with `cells`, also the outline of those cells (what a reading took, e.g. the panel's).
 struct ViewOverlay {
     Extent u, v;
     std::string label;
     cv::Scalar color{40, 40, 220}; // BGR
+    std::vector<std::array<float, 2>> cells; // lower corners (u, v) in mm, each cell_mm square
+    double cell_mm = 0;
 };
 
 struct RenderOptions {

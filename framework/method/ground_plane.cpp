@@ -158,9 +158,12 @@ ObjectOffset locateKnownObject(const CloudView &cloud, const KnownObject &truth,
     const double top = truth.center_mm[2] + truth.size_mm[2] / 2 + lateral_margin_mm;
     if (top < options.grid.z.max_mm) options.grid.z.max_mm = std::max(top, options.grid.z.min_mm + options.grid.cell_mm);
     options.expected_range_mm = off.true_range_mm;
+    options.expected_x_mm = off.true_x_mm;
+    options.expected_width_mm = truth.size_mm[0];
     const PanelReading r = readPanel(cloud, options);
     if (!r.registered) return off;
     off.found = true;
+    off.reading = r;
     off.measured_x_mm = (r.x_min_mm + r.x_max_mm) / 2;
     off.measured_range_mm = r.range_mm;
     off.lateral_mm = off.measured_x_mm - off.true_x_mm;

@@ -68,6 +68,7 @@ struct ObjectOffset {
     double distance_mm = 0;        // hypot(lateral, range)
     double measured_x_mm = 0, measured_range_mm = 0;
     double true_x_mm = 0, true_range_mm = 0;
+    PanelReading reading;          // locateKnownObject: its reading (edges, cells), for drawing
 };
 
 // Reads a known object where it should be, as the E1 panel is read (readPanel): the

@@ -81,7 +81,8 @@ const std::vector<Column> kMainColumns = {
     {"baseline_mm", "B", "mm", 0},          {"focal_length_mm", "f", "mm", 1},    {"range_mm", "R", "mm", 0},
     {"inclination_deg", "θ", "°", 1},        {"form_factor", "FF", "", 2},         {"epsilon_x_percent", "εx", "%", 1},
     {"epsilon_y_percent", "εy", "%", 1},    {"epsilon_z_percent", "εz", "%", 1},  {"eta_2d_percent", "η2D", "%", 1},
-    {"eta_3d_percent", "η3D", "%", 1},      {"valid_pixel_ratio", "valid px", "", 3}, {"seconds", "time", "s", 2}};
+    {"eta_3d_percent", "η3D", "%", 1},      {"eta_3d_oracle_percent", "η3D oracle", "%", 1},
+    {"valid_pixel_ratio", "valid px", "", 3}, {"seconds", "time", "s", 2}};
 
 // What the paper reported, per test id and figure: results.json's `paper_reported`
 // ({figure: {reported, measured, difference}}, written by the experiment from the
@@ -262,6 +263,33 @@ struct ImageProblems {
     std::vector<std::string> missing, unreadable; // "test_3: top view (XY)", "test_3/paper_top_000000.png"
 };
 
+// The value of the first column named "<evaluator>.<figure>" (whichever evaluator
+// reported it), or null.
+OJson figureOf(const OJson &row, const std::string &figure) {
+    for (const auto &[k, v] : row.items())
+        if (k.size() > figure.size() + 1 && k.compare(k.size() - figure.size() - 1, std::string::npos, "." + figure) == 0)
+            return v;
+    return OJson();
+}
+
+// What the reading took as the panel, in words beside the views that outline it.
+std::string readingLine(const OJson &row) {
+    const OJson x = figureOf(row, "measured_width_mm"), y = figureOf(row, "measured_range_mm"),
+                z = figureOf(row, "measured_height_mm");
+    if (x.is_null() && y.is_null() && z.is_null()) return "";
+    auto metres = [](const OJson &v) { return v.is_number() ? number(OJson(v.get<double>() / 1000), 2) + " m" : std::string("–"); };
+    std::ostringstream os;
+    os << "<p class=\"reading\">Read as the panel (outlined in red in the front and top views): X′ = " << metres(x)
+       << ", Y′ = " << metres(y) << ", Z′ = " << metres(z);
+    const OJson xo = figureOf(row, "measured_width_oracle_mm");
+    if (xo.is_number()) os << "; on the ground-truth disparity X′ = " << metres(xo);
+    const OJson reg = figureOf(row, "registered");
+    if (reg.is_number() && reg.get<double>() < 1)
+        os << " · registered in " << number(OJson(100 * reg.get<double>()), 0) << " % of the frames";
+    os << "</p>";
+    return os.str();
+}
+
 std::string testSections(const fs::path &dir, const OJson &results, ImageProblems &problems) {
     std::ostringstream os;
     for (const auto &row : results["tests"]) {
@@ -274,7 +302,7 @@ std::string testSections(const fs::path &dir, const OJson &results, ImageProblem
                << "</span> ";
         }
         if (row.contains("error")) os << "<span class=\"failed\">" << escape(row["error"].get<std::string>()) << "</span>";
-        os << "</p><div class=\"images\">";
+        os << "</p>" << readingLine(row) << "<div class=\"images\">";
         struct Item {
             const char *prefix, *label;
         };

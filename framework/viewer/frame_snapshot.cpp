@@ -46,6 +46,13 @@ std::vector<method::ViewOverlay> overlaysOf(const OJson &metrics, const char *vi
             v.v = {o["v_mm"][0].get<double>(), o["v_mm"][1].get<double>()};
             v.label = o.value("label", std::string());
             if (o.contains("bgr") && o["bgr"].size() == 3) v.color = cv::Scalar(o["bgr"][0], o["bgr"][1], o["bgr"][2]);
+            // The cells a reading took (the paper evaluator's panel), outlined.
+            if (o.contains("cells_mm") && o["cells_mm"].is_array() && o.contains("cell_mm") && o["cell_mm"].is_number()) {
+                v.cell_mm = o["cell_mm"].get<double>();
+                for (const auto &c : o["cells_mm"])
+                    if (c.is_array() && c.size() == 2 && c[0].is_number() && c[1].is_number())
+                        v.cells.push_back({c[0].get<float>(), c[1].get<float>()});
+            }
             out.push_back(v);
         }
     }

@@ -10,6 +10,7 @@
 #include "method/ground_plane.hpp"
 #include "method/panel.hpp"
 #include "method/relative_errors.hpp"
+#include "paper/oracle_cloud.hpp"
 #include "paper/rig_facts.hpp"
 
 #include <binocle/plugin.hpp>
@@ -102,6 +103,21 @@ public:
                 .help("the panel's band is looked for within the true range +- this"),
             Param::real("lateral_margin_mm", "0").min(0).unit("mm")
                 .help("> 0: read the panel only within its true lateral span +- this; 0: the whole grid"),
+            Param::choice("reading", "region", "region|band")
+                .help("region: the dense cells connected to the panel's stated position (a person's reading); "
+                      "band: every occupied cell of the range band (the reading before issue 33)"),
+            Param::real("panel_true_center_x_mm", "0").unit("mm")
+                .help("the panel's lateral middle (rough is enough); unset: the frame metadata's panel, else 0"),
+            Param::real("seed_half_width_mm", "1000").min(1).unit("mm")
+                .help("region reading: the panel has points within this of its stated lateral middle"),
+            Param::real("relative_density", "0.5").min(0).max(1)
+                .help("region reading: the panel's cells hold at least this share of its typical cell"),
+            Param::real("bridge_mm", "500").min(0).unit("mm")
+                .help("region reading: gaps inside the panel up to this wide are bridged"),
+            Param::boolean("oracle", true)
+                .help("e1: read the panel also on the cloud of the frame's gt_disparity (the sim's): *_oracle_* figures"),
+            Param::real("max_width_ratio", "2").min(1.01)
+                .help("region reading: a region wider than this times the true width is not separated (rejected)"),
             Param::integer("min_panel_points", "50").min(1).help("fewer panel points: not registered (rejected)"),
             Param::boolean("write_views", false)
                 .help("write the top, front and side density views as PNG into the output folder"),
@@ -159,6 +175,7 @@ public:
         const std::string calibrationText = in.calibration_yaml ? in.calibration_yaml : "";
         if (!calibrationParsed_ || calibrationText != calibrationText_) {
             calibration_ = paper::parseCalibrationFacts(in.calibration_yaml);
+            oracle_.setCalibration(calibrationText);
             calibrationText_ = calibrationText;
             calibrationParsed_ = true;
         }
@@ -178,7 +195,7 @@ public:
         double range = kNaN;
         std::optional<method::PanelPlacement> panel;
         if (e2_) range = evaluateE2(cloud, truth, drawings);
-        else range = evaluatePanel(cloud, truth, drawings, panel);
+        else range = evaluatePanel(cloud, truth, drawings, panel, in.frame);
         reportDesign(truth, range, panel ? &*panel : nullptr);
         host_.text("view_overlays", overlaysJson(drawings));
         if (p_.boolean("write_views")) writeViews(cloud, in.output_dir, drawings);
@@ -223,7 +240,7 @@ private:
     }
 
     double evaluatePanel(const method::CloudView &cloud, const paper::FrameTruth &truth, Drawings &drawings,
-                         std::optional<method::PanelPlacement> &placement) {
+                         std::optional<method::PanelPlacement> &placement, const binocle_stereo_frame *frame) {
         const method::PanelSize trueSize{given("panel_true_width_mm", truth.panel_width_mm),
                                          given("panel_true_range_mm", truth.panel_range_mm),
                                          given("panel_true_height_mm", truth.panel_height_mm)};
@@ -236,13 +253,11 @@ private:
                         "paper: no true panel size for Eq. 2-4 (missing:" + missing +
                             "): set them in the evaluator's YAML (tape-measured), or use a source whose frame metadata "
                             "has a `panel:` entry (sim)");
-        const double centerX = truth.panel_center_x_mm.value_or(0.0);
-        method::PanelReadingOptions o;
-        o.grid = grid_;
+        const double centerX = given("panel_true_center_x_mm", truth.panel_center_x_mm.value_or(0.0));
+        method::PanelReadingOptions o = readingOptions();
         o.expected_range_mm = trueSize.range_mm;
-        o.range_search_percent = p_.real("range_search_percent");
-        o.range_margin_mm = p_.real("range_margin_mm");
-        o.min_points = p_.integer("min_panel_points");
+        o.expected_x_mm = centerX;
+        o.expected_width_mm = trueSize.width_mm;
         if (p_.real("lateral_margin_mm") > 0) {
             const double half = trueSize.width_mm / 2 + p_.real("lateral_margin_mm");
             o.lateral = {centerX - half, centerX + half};
@@ -266,13 +281,10 @@ private:
         metric("true_height_mm", trueSize.height_mm, "mm");
         metric("panel_points", static_cast<double>(r.points));
         metric("panel_ground_z_mm", r.ground_z_mm, "mm");
-        if (r.registered) {
-            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
-                                      "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Z' " + fixed(r.height_mm / 1000, 2) + " m",
-                                      {40, 40, 220}});
-            drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m",
-                                     {40, 40, 220}});
-        }
+        metric("panel_cell_threshold", r.cell_threshold);
+        metric("panel_band_depth_mm", r.band.valid() ? r.band.size() : kNaN, "mm");
+        drawReading(r, drawings);
+        if (p_.boolean("oracle")) scoreOracle(frame, o, trueSize, s);
         placement = method::PanelPlacement{trueSize.width_mm, trueSize.height_mm, centerX,
                                            truth.panel_base_z_mm.value_or(0.0)};
         return trueSize.range_mm;
@@ -303,11 +315,7 @@ private:
                         "paper (experiment e2): no known object" + (name.empty() ? std::string() : " named '" + name + "'") +
                             " in the frame metadata: set `object` to the name of one of its objects, or "
                             "object_center_mm and object_size_mm");
-        method::PanelReadingOptions o;
-        o.grid = grid_;
-        o.range_search_percent = p_.real("range_search_percent");
-        o.range_margin_mm = p_.real("range_margin_mm");
-        o.min_points = p_.integer("min_panel_points");
+        const method::PanelReadingOptions o = readingOptions();
         const method::ObjectOffset off = method::locateKnownObject(cloud, known, o, p_.real("object_margin_mm"));
         if (!off.found)
             host_.warning("frame " + std::to_string(sequence_) + ": known object '" + known.name +
@@ -319,10 +327,16 @@ private:
         metric("true_range_mm", off.true_range_mm, "mm");
         metric("object_offset_lateral_mm", off.found ? off.lateral_mm : kNaN, "mm");
         metric("object_offset_range_mm", off.found ? off.range_mm : kNaN, "mm");
-        if (off.found)
-            drawings.top.push_back({{off.measured_x_mm - known.size_mm[0] / 2, off.measured_x_mm + known.size_mm[0] / 2},
+        if (off.found) { // what was read as the known object, outlined (README: the views)
+            const method::PanelReading &r = off.reading;
+            drawings.top.push_back({{r.x_min_mm, r.x_max_mm},
                                     {off.measured_range_mm, off.measured_range_mm + known.size_mm[1]},
-                                    known.name, {40, 40, 220}});
+                                    known.name + " Y' " + fixed(off.measured_range_mm / 1000, 2) + " m",
+                                    {40, 40, 220}, r.top_cells, grid_.cell_mm});
+            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
+                                      known.name + " X " + fixed(off.measured_x_mm / 1000, 2) + " m",
+                                      {40, 40, 220}, r.front_cells, grid_.cell_mm});
+        }
 
         // The ground plane, and the inclination it gives back (Eq. 1 applied with the
         // ground transform's inclination).
@@ -342,6 +356,63 @@ private:
         metric("inclination_true_deg", trueInclination, "deg");
         metric("angular_error_deg", recovered - trueInclination, "deg");
         return off.true_range_mm;
+    }
+
+    // The same reading on the cloud of the ground-truth disparity (oracle_cloud.hpp): what
+    // the camera configuration alone allows; the difference is what the matcher costs.
+    // Nothing is reported when the frame carries no gt_disparity.
+    void scoreOracle(const binocle_stereo_frame *frame, const method::PanelReadingOptions &o,
+                     const method::PanelSize &trueSize, const method::PanelScore &measured) {
+        const auto cloud = oracle_.groundCloud(frame, rig_.applied_camera_height_mm, rig_.applied_inclination_deg);
+        if (!cloud) return;
+        const method::PanelReading r = method::readPanel(method::CloudView(*cloud), o);
+        const method::PanelScore s = method::scorePanel(r.size(), trueSize, r.registered);
+        if (!r.registered)
+            host_.warning("frame " + std::to_string(sequence_) + ": panel not registered on the ground-truth cloud (oracle): " + r.reason);
+        metric("registered_oracle", r.registered ? 1 : 0);
+        metric("epsilon_x_oracle_percent", s.epsilon_x_percent, "%");
+        metric("epsilon_y_oracle_percent", s.epsilon_y_percent, "%");
+        metric("epsilon_z_oracle_percent", s.epsilon_z_percent, "%");
+        metric("eta_2d_oracle_percent", s.eta_2d_percent, "%");
+        metric("eta_3d_oracle_percent", s.eta_3d_percent, "%");
+        metric("measured_width_oracle_mm", r.width_mm, "mm");
+        metric("eta_3d_matcher_loss_percent", s.eta_3d_percent - measured.eta_3d_percent, "%");
+    }
+
+    // How the panel (e1) or the known object (e2) is read, from the settings.
+    method::PanelReadingOptions readingOptions() const {
+        method::PanelReadingOptions o;
+        o.grid = grid_;
+        o.range_search_percent = p_.real("range_search_percent");
+        o.range_margin_mm = p_.real("range_margin_mm");
+        o.min_points = p_.integer("min_panel_points");
+        o.method = p_.string("reading") == "band" ? method::PanelReadingMethod::Band : method::PanelReadingMethod::Region;
+        o.seed_half_width_mm = p_.real("seed_half_width_mm");
+        o.relative_density = p_.real("relative_density");
+        o.bridge_mm = p_.real("bridge_mm");
+        o.max_width_ratio = p_.real("max_width_ratio");
+        return o;
+    }
+
+    // What the reading took, drawn over the views: the outline of the panel's cells in
+    // the front (X, Z) and top (X, Y) views, its box and X', Y', Z' (README: the report
+    // and `binocle view` show them, so that a person can check each figure by eye).
+    void drawReading(const method::PanelReading &r, Drawings &drawings) const {
+        const cv::Scalar red{40, 40, 220};
+        const double cell = grid_.cell_mm;
+        if (!r.registered) {
+            if (r.front_cells.empty()) return;
+            drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm}, "not separated", red,
+                                      r.front_cells, cell});
+            return;
+        }
+        drawings.front.push_back({{r.x_min_mm, r.x_max_mm}, {r.z_bottom_mm, r.z_top_mm},
+                                  "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Z' " + fixed(r.height_mm / 1000, 2) + " m",
+                                  red, r.front_cells, cell});
+        drawings.top.push_back({{r.x_min_mm, r.x_max_mm}, r.band,
+                                "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Y' " + fixed(r.range_mm / 1000, 2) + " m",
+                                red, r.top_cells, cell});
+        drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m", red});
     }
 
     // Eq. 7 and the sensor-aware figures, when B, f and p are known.
@@ -395,11 +466,17 @@ private:
         nlohmann::ordered_json j = nlohmann::ordered_json::object();
         auto list = [](const std::vector<method::ViewOverlay> &v) {
             nlohmann::ordered_json a = nlohmann::ordered_json::array();
-            for (const method::ViewOverlay &o : v)
+            for (const method::ViewOverlay &o : v) {
                 a.push_back({{"u_mm", {o.u.min_mm, o.u.max_mm}},
                              {"v_mm", {o.v.min_mm, o.v.max_mm}},
                              {"label", o.label},
                              {"bgr", {o.color[0], o.color[1], o.color[2]}}});
+                if (o.cells.empty()) continue;
+                nlohmann::ordered_json cells = nlohmann::ordered_json::array();
+                for (const auto &c : o.cells) cells.push_back({c[0], c[1]});
+                a.back()["cell_mm"] = o.cell_mm;
+                a.back()["cells_mm"] = std::move(cells);
+            }
             return a;
         };
         j["top"] = list(d.top);
@@ -455,6 +532,7 @@ private:
     bool e2_ = false;
     method::GridSpec grid_;
     std::optional<std::vector<double>> objectCenter_, objectSize_;
+    paper::OracleProjector oracle_;
     paper::RigFacts calibration_, rig_; // the calibration's facts; with the host's of this frame
     std::string calibrationText_;
     bool calibrationParsed_ = false;
@@ -466,6 +544,7 @@ private:
 
 } // namespace
 
-BINOCLE_EXPORT_EVALUATOR(PaperEvaluator, "paper", "1.0.0",
-                         "METHOD.md: E1 panel relative errors and efficiencies (Eq. 2-6), E2 ground and object "
-                         "indicators, form factor (Eq. 7), density-grid views and objects")
+BINOCLE_EXPORT_EVALUATOR(PaperEvaluator, "paper", "1.1.0",
+                         "METHOD.md: E1 panel relative errors and efficiencies (Eq. 2-6) read as a person reads the "
+                         "views, with the ground-truth oracle; E2 ground and object indicators, form factor (Eq. 7), "
+                         "density-grid views and objects")

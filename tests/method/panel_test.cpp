@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace binocle::test {
 namespace {
@@ -122,12 +123,127 @@ TEST(PanelReading, AFloatingPanelIsMeasuredFromItsLowerEdge) {
     EXPECT_NEAR(r.height_mm, 2000, 12);
 }
 
+// ---- Hard cases of the region reading (README: "Reading X', Y', Z' of the E1 panel") ----
+
+// The E1 panel (10 mm spacing, 5 mm noise) on a ground, plus whatever `more` adds.
+template <typename More>
+std::vector<float> panelWith(More more, double range = 6000) {
+    SyntheticScene scene;
+    scene.range_mm = range;
+    CloudBuilder b(11);
+    const std::vector<float> base = panelScene(scene);
+    b.xyz = base;
+    more(b);
+    return b.xyz;
+}
+
+// A wall beside the panel at the same range, touching its right edge, a quarter as dense
+// (a plainer surface the matcher matched less): split at the density edge.
+TEST(PanelRegion, SplitsAWallBesideThePanelAtItsDensityEdge) {
+    const auto xyz = panelWith([](CloudBuilder &b) { b.frontFace(1250, 5000, 0, 3000, 6050, 20, 5); });
+    const PanelReading r = readPanel(CloudView(xyz), options());
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR(r.x_min_mm, -1250, 30) << describe(r);
+    EXPECT_NEAR(r.x_max_mm, 1250, 60) << describe(r);
+    // The reading before issue 33 took the wall with it.
+    PanelReadingOptions band = options();
+    band.method = PanelReadingMethod::Band;
+    EXPECT_GT(readPanel(CloudView(xyz), band).width_mm, 5500);
+}
+
+// Ground points lifted into the band (a depth error of the ground at range) along the
+// whole field, as dense as the panel in their rows: the panel's edges are where most of
+// its rows end, so the strip along the bottom does not widen it.
+TEST(PanelRegion, GroundClutterAlongTheBottomDoesNotWidenIt) {
+    const auto xyz = panelWith([](CloudBuilder &b) {
+        for (double y = 5700; y <= 6300; y += 150) b.topFace(-5000, 5000, y, y + 10, 250, 10, 40);
+    });
+    const PanelReading r = readPanel(CloudView(xyz), options());
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR(r.width_mm, 2500, 150) << describe(r);
+    EXPECT_TRUE(r.stands_on_ground);
+}
+
+// A matcher's smear beside the top cubes: points spread in range between the panel and
+// the background (a depth step in the top view), as dense as the panel in the front view
+// of the whole cloud. The band narrowed to the panel's own depth keeps most of it out,
+// and the rest is under the panel's density.
+TEST(PanelRegion, SmearedFillBesideThePanelIsLeftOut) {
+    const auto xyz = panelWith([](CloudBuilder &b) {
+        std::uniform_real_distribution<double> x(1250, 2200), z(1400, 2100), y(4200, 6400);
+        for (int i = 0; i < 6000; ++i) b.point(x(b.rng()), y(b.rng()), z(b.rng()));
+    });
+    const PanelReading r = readPanel(CloudView(xyz), options());
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR(r.x_max_mm, 1250, 80) << describe(r);
+    EXPECT_NEAR(r.width_mm, 2500, 120) << describe(r);
+}
+
+// The panel partly out of the stereo field: the reading takes what the cloud shows
+// (the paper evaluator reports panel_fits beside it).
+TEST(PanelRegion, APanelCutByTheFieldIsReadAsFarAsItIsSeen) {
+    std::vector<float> xyz;
+    const std::vector<float> all = panelScene();
+    for (size_t i = 0; i < all.size(); i += 3)
+        if (all[i] < 1100) xyz.insert(xyz.end(), {all[i], all[i + 1], all[i + 2]});
+    const PanelReading r = readPanel(CloudView(xyz), options());
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR(r.x_min_mm, -1250, 30) << describe(r);
+    EXPECT_NEAR(r.x_max_mm, 1100, 60) << describe(r);
+}
+
+// The middle column not matched (OpenCV's bm on the chessboard at 12 m): the outer
+// columns are within a metre of the stated position and give the width.
+TEST(PanelRegion, AMissingMiddleColumnStillGivesTheOuterEdges) {
+    std::vector<float> xyz;
+    const std::vector<float> all = panelScene();
+    for (size_t i = 0; i < all.size(); i += 3)
+        if (std::abs(all[i]) > 300 || all[i + 2] < 150) xyz.insert(xyz.end(), {all[i], all[i + 1], all[i + 2]});
+    const PanelReading r = readPanel(CloudView(xyz), options());
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR(r.width_mm, 2500, 30) << describe(r);
+}
+
+// Clutter as dense as the panel, at its range and touching it over its whole height (a
+// wall flush with its face): nothing tells them apart, and the reading says so instead
+// of reading a 5 m panel.
+TEST(PanelRegion, AWallFlushWithThePanelIsNotSeparated) {
+    const auto xyz = panelWith([](CloudBuilder &b) { b.frontFace(1250, 5000, 0, 2000, 6000, 10, 5); });
+    PanelReadingOptions o = options();
+    o.expected_width_mm = 2500;
+    const PanelReading r = readPanel(CloudView(xyz), o);
+    EXPECT_FALSE(r.registered) << describe(r);
+    EXPECT_NE(r.reason.find("not separated"), std::string::npos) << r.reason;
+    EXPECT_TRUE(std::isnan(r.width_mm));
+    EXPECT_FALSE(r.front_cells.empty()); // what it took is still there to draw
+}
+
+// The stated lateral position is where the reading starts: a panel 3 m to the right
+// is found when it is stated there, and not when it is stated in front of the rig.
+TEST(PanelRegion, StartsAtTheStatedLateralPosition) {
+    std::vector<float> xyz = panelScene();
+    for (size_t i = 0; i < xyz.size(); i += 3)
+        if (xyz[i + 2] > 150) xyz[i] += 3000; // the panel, not the ground
+    PanelReadingOptions o = options();
+    o.expected_x_mm = 3000;
+    const PanelReading r = readPanel(CloudView(xyz), o);
+    ASSERT_TRUE(r.registered) << r.reason;
+    EXPECT_NEAR((r.x_min_mm + r.x_max_mm) / 2, 3000, 30) << describe(r);
+    EXPECT_FALSE(readPanel(CloudView(xyz), options()).registered);
+}
+
 TEST(PanelReading, RefusesBadOptions) {
     PanelReadingOptions o = options();
     o.range_margin_mm = 0;
     EXPECT_THROW(readPanel(CloudView(), o), std::invalid_argument);
     o = options();
     o.grid.cell_mm = -1;
+    EXPECT_THROW(readPanel(CloudView(), o), std::invalid_argument);
+    o = options();
+    o.relative_density = 1.5;
+    EXPECT_THROW(readPanel(CloudView(), o), std::invalid_argument);
+    o = options();
+    o.seed_half_width_mm = 0;
     EXPECT_THROW(readPanel(CloudView(), o), std::invalid_argument);
 }
 

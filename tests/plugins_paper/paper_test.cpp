@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
@@ -65,6 +66,7 @@ struct Input {
     bool ground_pose = false;                       // the ground frame's transform declared:
     double camera_height_mm = 0, inclination_deg = 0;
     uint32_t struct_size = sizeof(binocle_eval_input); // an older host passes less
+    std::vector<binocle_named_image> extras;            // e.g. gt_disparity
 
     binocle_cloud cloud{};
     binocle_stereo_frame f{};
@@ -77,6 +79,8 @@ struct Input {
         f.struct_size = sizeof f;
         f.sequence = sequence;
         f.metadata = metadata.empty() ? nullptr : metadata.c_str();
+        f.extras = extras.empty() ? nullptr : extras.data();
+        f.extra_count = static_cast<int32_t>(extras.size());
         in.struct_size = struct_size;
         in.frame = &f;
         in.min_disparity = min_disparity;
@@ -283,6 +287,75 @@ TEST(PaperPlugin, WritesTheThreeDensityViews) {
     EXPECT_FALSE(run.warnings.empty());
 }
 
+// What the reading took is drawn: the outline of the panel's cells in the front and top
+// views (view_overlays, which `binocle view` draws) and in the PNG views (the report's).
+TEST(PaperPlugin, TheReadCellsAreDrawnOverTheViews) {
+    TempDir dir;
+    PaperRun run(std::string(kTapeMeasured).insert(1, "write_views: true, "));
+    Input input;
+    input.xyz = panelScene();
+    input.output_dir = dir.str();
+    run.evaluator->evaluate(input.get());
+    const nlohmann::json overlays = nlohmann::json::parse(run.texts.at("view_overlays"));
+    for (const char *view : {"front", "top"}) {
+        const nlohmann::json *panel = nullptr;
+        for (const auto &o : overlays[view])
+            if (o.contains("cells_mm")) panel = &o;
+        ASSERT_NE(panel, nullptr) << view << ": " << overlays.dump();
+        EXPECT_EQ((*panel)["cell_mm"], 100);
+        EXPECT_NE((*panel)["label"].get<std::string>().find("X' 2.50 m"), std::string::npos) << (*panel)["label"];
+        for (const auto &c : (*panel)["cells_mm"]) {
+            EXPECT_GE(c[0].get<double>(), -1300) << view;
+            EXPECT_LT(c[0].get<double>(), 1300) << view;
+        }
+    }
+    // The front view's picture has the outline's colour (BGR 40, 40, 220) where the panel is.
+    const cv::Mat front = cv::imread(dir.str("paper_front_000007.png"));
+    ASSERT_FALSE(front.empty());
+    cv::Mat red;
+    cv::inRange(front, cv::Scalar(30, 30, 200), cv::Scalar(60, 60, 240), red);
+    EXPECT_GT(cv::countNonZero(red), 400);
+}
+
+// The oracle: a frame carrying gt_disparity (as the sim's does) is read a second time
+// on the cloud that disparity gives through the calibration's Q and Eq. 1; a frame
+// without it reports no oracle figure.
+TEST(PaperPlugin, OracleReadsTheGroundTruthDisparity) {
+    const double f = 400, cx = 159.5, cy = 119.5, B = 100, hc = 1500, Zc = 6000;
+    cv::Mat gt(240, 320, CV_32F, cv::Scalar(-1));
+    for (int v = 0; v < gt.rows; ++v)
+        for (int u = 0; u < gt.cols; ++u) {
+            const double X = (u - cx) * Zc / f, Z = hc - (v - cy) * Zc / f;
+            const double col = (X + 1250) / 1000, row = Z / 750;
+            const bool cube = X >= -1250 && X < 1250 && Z >= 0 && Z < 2000 && col - std::floor(col) < 0.5 &&
+                              row - std::floor(row) < 2.0 / 3;
+            if (cube) gt.at<float>(v, u) = static_cast<float>(f * B / Zc);
+            else if (v > cy) gt.at<float>(v, u) = static_cast<float>(B * (v - cy) / hc); // the ground
+        }
+    const std::string calibration = "%YAML:1.0\n---\nQ: !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n   data: [1, 0, 0, " +
+                                    std::to_string(-cx) + ", 0, 1, 0, " + std::to_string(-cy) + ", 0, 0, 0, " +
+                                    std::to_string(f) + ", 0, 0, " + std::to_string(1 / B) + ", 0]\n";
+    PaperRun run(kTapeMeasured);
+    Input input;
+    input.xyz = panelScene();
+    input.calibration = calibration;
+    input.ground_pose = true;
+    input.camera_height_mm = hc;
+    input.extras.push_back({"gt_disparity", {gt.cols, gt.rows, static_cast<int32_t>(gt.step), BINOCLE_PIXEL_FLOAT32, gt.data}});
+    run.evaluator->evaluate(input.get());
+    EXPECT_EQ(run["registered_oracle"], 1);
+    EXPECT_GT(run["eta_3d_oracle_percent"], 97);
+    EXPECT_NEAR(run["measured_width_oracle_mm"], 2500, 60);
+    EXPECT_NEAR(run["eta_3d_matcher_loss_percent"], run["eta_3d_oracle_percent"] - run["eta_3d_percent"], 1e-9);
+
+    PaperRun without(kTapeMeasured);
+    Input plain;
+    plain.xyz = panelScene();
+    plain.calibration = calibration;
+    without.evaluator->evaluate(plain.get());
+    EXPECT_EQ(without.metrics.count("eta_3d_oracle_percent"), 0u);
+}
+
 TEST(PaperPlugin, FinishReportsMeansOverTheRun) {
     PaperRun run(kTapeMeasured);
     Input good;
@@ -323,6 +396,10 @@ objects:
     run.evaluator->evaluate(input.get());
     EXPECT_EQ(run["registered"], 1);
     EXPECT_NEAR(run["object_offset_lateral_mm"], -40, 10);
+    // The cells read as the marker are outlined in the front view too.
+    const nlohmann::json overlays = nlohmann::json::parse(run.texts.at("view_overlays"));
+    ASSERT_FALSE(overlays["front"].empty()) << overlays.dump();
+    EXPECT_FALSE(overlays["front"][0]["cells_mm"].empty()) << overlays.dump();
     EXPECT_NEAR(run["object_offset_range_mm"], 0, 5);
     EXPECT_LT(run["epsilon_y_percent"], 0.1);
     EXPECT_EQ(run["inclination_applied_deg"], 5.5);

@@ -69,6 +69,27 @@ try:
     check(len(images) == 12, f"4 images per test ({len(images)})")
     check(all(w > 0 and src.startswith("data:image/png;base64") for _, w, src in images),
           "every image is inlined and decodes: " + ", ".join(a for a, w, _ in images if w == 0))
+    # What the reading took: in words under each test, and outlined in red (BGR 40, 40, 220)
+    # over its front view, so that every figure can be checked by eye.
+    readings = driver.execute_script(
+        "return Array.from(document.querySelectorAll('section.test')).map(s => "
+        "(s.querySelector('p.reading') || {textContent: ''}).textContent)")
+    check(len(readings) == 3 and all("X′ = " in r and "Z′ = " in r for r in readings),
+          f"each test says what was read as the panel ({readings})")
+    outlined = driver.execute_script("""
+        return Array.from(document.querySelectorAll('section.test img'))
+          .filter(i => i.alt.endsWith('front view (XZ)')).map(i => {
+            const c = document.createElement('canvas');
+            c.width = i.naturalWidth; c.height = i.naturalHeight;
+            const g = c.getContext('2d');
+            g.drawImage(i, 0, 0);
+            const d = g.getImageData(0, 0, c.width, c.height).data;
+            let n = 0;
+            for (let k = 0; k < d.length; k += 4)
+              if (d[k] > 200 && d[k] < 240 && d[k + 1] > 30 && d[k + 1] < 60 && d[k + 2] > 30 && d[k + 2] < 60) ++n;
+            return n; })""")
+    check(len(outlined) == 3 and all(n > 200 for n in outlined),
+          f"the panel's cells are outlined over every front view (red pixels: {outlined})")
     provenance = driver.find_element("id", "provenance").get_attribute("textContent")
     check("binocle" in provenance and "OpenCV" in provenance and "sgbm" in provenance and "matcher:" in provenance,
           "the rig and the software versions are stated")

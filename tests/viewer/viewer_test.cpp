@@ -172,6 +172,29 @@ TEST(ViewerServer, BusyPortIsNamed) {
     }
 }
 
+// The cells an evaluator's reading took (view_overlays' cells_mm, the paper evaluator's
+// panel) are outlined over the live density views, in the overlay's colour.
+TEST(ViewerFrame, OutlinesTheCellsAReadingTook) {
+    viewer::FrameProducts p;
+    p.result.cloud.frame = BINOCLE_FRAME_GROUND;
+    for (int i = 0; i < 3000; ++i)
+        p.result.cloud.xyz.insert(p.result.cloud.xyz.end(), {float(i % 1000) - 500.f, 6000.f, 300.f + float(i / 3)});
+    method::GridSpec grid;
+    auto red = [&](const std::string &overlays) {
+        p.metrics = {{"paper", {{"view_overlays", overlays}}}};
+        const std::vector<cv::Mat> views = viewer::renderDensityViews(p, grid, 400);
+        cv::Mat mask;
+        cv::inRange(views[1], cv::Scalar(0, 0, 250), cv::Scalar(5, 5, 255), mask); // the front view
+        return cv::countNonZero(mask);
+    };
+    // The box itself out of the way (beyond the grid): what is red is the cells' outline.
+    const std::string box = R"("u_mm":[7000,7001],"v_mm":[300,301],"label":"","bgr":[0,0,255])";
+    EXPECT_EQ(red("{\"front\":[{" + box + "}]}"), 0);
+    std::string cells = "{\"front\":[{" + box + R"(,"cell_mm":100,"cells_mm":[)";
+    for (int c = 0; c < 5; ++c) cells += std::string(c ? "," : "") + "[" + std::to_string(-500 + 200 * c) + ",600]";
+    EXPECT_GE(red(cells + "]}]}"), 5 * 8) << "five separate cells, each outlined";
+}
+
 TEST(ViewerFrame, MessageLayout) {
     viewer::FrameProducts p;
     p.result.sequence = 7;
