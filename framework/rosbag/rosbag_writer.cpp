@@ -162,6 +162,17 @@ void RosbagWriter::writePair(int64_t stampLeftNs, int64_t stampRightNs, const cv
             write(sideNs + "camera_info", ros2::CameraInfo::kType, stamp, ros2::encode(info));
         }
     }
+    pairEnds_.push_back(writer_->statistics().message_count);
+}
+
+int64_t RosbagWriter::durablePairs() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const uint64_t durable = writer_->durableMessageCount();
+    while (!pairEnds_.empty() && pairEnds_.front() <= durable) {
+        pairEnds_.pop_front();
+        ++durablePairs_;
+    }
+    return durablePairs_;
 }
 
 void RosbagWriter::writeDisparity(int64_t stampNs, const cv::Mat &disparity, double focalLengthPx, double baselineM,

@@ -19,6 +19,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -72,6 +73,10 @@ public:
     const std::string &file() const { return file_; }
     uint64_t messageCount() const;
     uint64_t bytesWritten() const;
+    // The pairs (writePair calls) a reader of the bag recovers whole: those whose every
+    // message lies in a chunk written whole (mcap::Writer::durableMessageCount). What a
+    // recording may claim, on a full disk too.
+    int64_t durablePairs();
 
 private:
     uint16_t channel(const std::string &topic, const char *type);
@@ -85,6 +90,8 @@ private:
     std::optional<StereoCalibration> calibration_;
     std::map<std::string, std::pair<uint16_t, std::string>> channels_; // topic -> id, type
     std::map<std::string, uint64_t> counts_;
+    std::deque<uint64_t> pairEnds_; // the message count after each pair not yet durable
+    int64_t durablePairs_ = 0;
     uint32_t sequence_ = 0;
     int64_t first_ = INT64_MAX, last_ = INT64_MIN;
     bool closed_ = false;
