@@ -38,9 +38,14 @@ struct RosbagOptions {
     int compression_level = 1;
 };
 
-// Refuses what ROS would: a namespace that is not "/" followed by [A-Za-z0-9_/] names, a
-// frame id with spaces. Throws binocle::Error naming the option and the value.
+// Refuses what ROS would: a namespace that breaks ROS 2's rule (rcl's namespace
+// validation: "/" alone, or "/"-joined names of [A-Za-z0-9_] not starting with a digit, no
+// "//", no trailing "/"), a frame id with spaces. Throws binocle::Error naming the option
+// and the value.
 void checkRosbagOptions(const RosbagOptions &options);
+// Why `ns` is not a ROS 2 namespace ("'//x': it holds '//' ...; ROS 2 expects ..."), or
+// empty: what --ros-namespace's validator answers.
+std::string rosNamespaceRefusal(const std::string &ns);
 
 class RosbagWriter {
 public:
