@@ -49,7 +49,8 @@ struct KindName {
 constexpr KindName kKinds[] = {{OutputKind::Run, "run", "the output of a run"},
                                {OutputKind::Recording, "recording", "a recording"},
                                {OutputKind::Experiment, "experiment", "an experiment's results"},
-                               {OutputKind::Design, "design", "a design's ranking"}};
+                               {OutputKind::Design, "design", "a design's ranking"},
+                               {OutputKind::View, "view", "the viewer's snapshots"}};
 
 // The marker's kind and command; kind None when there is no marker (or not one of ours).
 std::pair<OutputKind, std::string> markerOf(const fs::path &dir) {
@@ -135,7 +136,13 @@ OutputFolder::OutputFolder(const std::string &dir, const OutputClaim &claim) : d
     const auto status = fs::symlink_status(dir, ec);
     if (fs::exists(status) && !fs::is_directory(fs::status(dir, ec)))
         throw Error("output folder " + dir + ": exists and is not a folder");
-    created_ = !fs::exists(status);
+    // The folders this claim makes (DIR and any missing parent), deepest first.
+    fs::path deepest = fs::path(dir).lexically_normal();
+    if (deepest.filename().empty()) deepest = deepest.parent_path(); // "out/view/"
+    for (fs::path p = deepest; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+        created_.push_back(p.string());
+        if (p == p.parent_path()) break;
+    }
     fs::create_directories(dir, ec);
     if (ec) throw Error("output folder " + dir + ": cannot create the folder: " + ec.message());
     lock(claim.command);
@@ -230,9 +237,10 @@ void OutputFolder::release() {
     // A folder this claim made and nothing was written into (the command was refused
     // before its first output) goes again, marker and all; rmdir leaves any folder that
     // holds something.
-    if (created_ && entriesOf(dir_).empty()) {
+    if (!created_.empty() && entriesOf(dir_).empty()) {
         ::unlink((fs::path(dir_) / kMarkerFile).c_str());
-        ::rmdir(dir_.c_str());
+        for (const std::string &d : created_)
+            if (::rmdir(d.c_str()) != 0) break;
     }
 }
 

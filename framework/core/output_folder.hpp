@@ -19,6 +19,7 @@ enum class OutputKind {
     Recording,  // `binocle record`: frames.csv, or a rosbag2 bag (metadata.yaml, *.mcap)
     Experiment, // `binocle experiment` / `experiment merge`, binocle.experiment(out=): results.json or results.csv
     Design,     // `binocle design --out`: design.json, design.csv (and simulated/)
+    View,       // `binocle view --out`: the viewer's snapshots
 };
 
 // "a recording", for messages.
@@ -70,7 +71,9 @@ private:
     std::string dir_;
     std::string lockPath_;
     int fd_ = -1;
-    bool created_ = false; // made by this claim: removed again when it ends empty (a refused run leaves nothing)
+    // Made by this claim (DIR and its missing parents, deepest first): removed again when
+    // DIR ends empty (a refused run, a view without a snapshot, leave nothing).
+    std::vector<std::string> created_;
 };
 
 } // namespace binocle

@@ -138,8 +138,9 @@ TEST(OutputFolder, AFolderBelongsToTheCommandThatMadeIt) {
     why = errorOf([&] { OutputFolder(made, OutputClaim{OutputKind::Experiment, false, "binocle experiment"}); });
     EXPECT_NE(why.find("holds the output of a run (frames.jsonl), made by binocle run"), std::string::npos) << why;
 
+    // A claim that wrote nothing takes back the folders it made, parents too.
     const std::string fresh = dir.str("fresh");
-    { OutputFolder nothing(fresh, OutputClaim{OutputKind::Run, false, "binocle run"}); }
+    { OutputFolder nothing(fresh + "/deeper/", OutputClaim{OutputKind::View, false, "binocle view"}); }
     EXPECT_FALSE(fs::exists(fresh));
 }
 
