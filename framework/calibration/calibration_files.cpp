@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -84,10 +86,27 @@ void writeCalibrationFiles(const CalibrationFiles &files, const StereoCalibratio
         fs::create_directories(dir, ec);
         if (ec) throw Error("--out " + files.calibration + ": cannot create the folder " + dir.string() + ": " + ec.message());
     }
-    writeFileAtomic(files.report, json);
-    writeFileAtomic(files.left_info, left);
-    writeFileAtomic(files.right_info, right);
-    c.save(files.calibration);
+    // A write that fails (a full disk) takes back the files written before it: a report
+    // that reads as finished never stands beside no calibration file.
+    std::vector<std::string> written;
+    try {
+        for (const auto &[path, text] : {std::pair<const std::string &, const std::string &>{files.report, json},
+                                         {files.left_info, left},
+                                         {files.right_info, right}}) {
+            writeFileAtomic(path, text);
+            written.push_back(path);
+        }
+        c.save(files.calibration);
+    } catch (const Error &e) {
+        std::string removed;
+        for (const auto &path : written) {
+            std::error_code ec;
+            fs::remove(path, ec);
+            removed += (removed.empty() ? "" : ", ") + path;
+        }
+        throw Error(std::string(e.what()) +
+                    (removed.empty() ? "" : "; removed what this calibration had written before it (" + removed + ")"));
+    }
 }
 
 } // namespace binocle

@@ -28,7 +28,8 @@ struct CalibrationFiles {
 };
 
 // Writes them all, each atomically; the calibration file last, so that its presence
-// means the others are complete. Creates the folder when needed.
+// means the others are complete. When a write fails (a full disk) the files written
+// before it are removed again and the error says so. Creates the folder when needed.
 void writeCalibrationFiles(const CalibrationFiles &files, const StereoCalibration &calibration, const Json &report);
 
 } // namespace binocle

@@ -7,6 +7,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/json.hpp"
+#include "core/output_folder.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/predictor_choice.hpp"
 #include "input/numbers.hpp"
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <spdlog/spdlog.h>
 #include <sstream>
 
@@ -33,7 +35,7 @@ struct DesignArgs {
     method::StereoDesign head = method::videreHead();
     double panel_width_mm = 2500, panel_height_mm = 2000;
     int top = 10, simulate_count = 12;
-    bool simulate = false, quiet = false;
+    bool simulate = false, quiet = false, force = false;
     std::string rig, out;
     std::string predictors_from, predictor; // empty: the shipped file; the best of it
 };
@@ -270,6 +272,10 @@ int design(const DesignArgs &args) {
     const Hardware hw = hardwareOf(args);
     const std::string predictor = choosePredictor(args);
     std::vector<Candidate> cands = rankCandidates(args, hw, ranges, predictor);
+    // --out is the design's own folder (marked): another command's, or the user's own
+    // files, are refused unless --force.
+    std::optional<OutputFolder> folder;
+    if (!args.out.empty()) folder.emplace(args.out, OutputClaim{OutputKind::Design, args.force, "binocle design"});
     if (args.simulate) simulate(args, ranges, cands);
     writeRanking(args, cands, predictor);
     return 0;
@@ -317,6 +323,7 @@ Register designCommand{{"design", "rank baselines and lenses for a target range 
                       addNumber(app, "--simulate-count", a.simulate_count, "how many candidates to simulate (default 12)", "N", atLeast(1));
                       app.add_option("--rig", a.rig, "base rig for --simulate (default configs/rigs/sim-e1.yaml)")->type_name("FILE");
                       app.add_option("--out", a.out, "write design.json and design.csv (and simulated/ runs)")->type_name("DIR");
+                      app.add_flag("--force", a.force, "replace what --out holds when another command (or you) wrote it");
                       app.add_flag("--quiet", a.quiet, "no progress display");
                   },
                   design)}};

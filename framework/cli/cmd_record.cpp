@@ -45,8 +45,9 @@ int record(const RecordArgs &args) {
     options.format = args.format;
     options.rosbag = args.rosbag;
     checkRosbagOptions(options.rosbag);
-    // One recorder per folder; the writer itself refuses a folder that holds anything.
-    OutputFolder folder(args.out, OutputClaim{OutputKind::None, false, "binocle record"});
+    // One recorder per folder, marked as a recording; the writer itself refuses a folder
+    // that holds anything (a recording is never written over, --force or not).
+    OutputFolder folder(args.out, OutputClaim{OutputKind::Recording, false, "binocle record"});
     RecordResult r = recordRig(rig, args.out, options);
     spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, args.out, r.seconds);
     // Where every pair that was not written went (also in DIR/summary.json).
@@ -118,7 +119,8 @@ Register recordCommand{{"record", "record a rig's source (any plugin) to a folde
                           ->check(CLI::IsMember({"folder", "mcap"}));
                       app.add_option("--ros-namespace", args.rosbag.ros_namespace,
                                      "mcap: the topics' namespace (default /binocle: /binocle/left/image_raw ...)")
-                          ->type_name("NS");
+                          ->type_name("NS")
+                          ->check(CLI::Validator(rosNamespaceRefusal, "NS"));
                       app.add_option("--frame-id-left", args.rosbag.frame_id_left,
                                      "mcap: header.frame_id of the left images (default binocle_left_optical)")
                           ->type_name("ID");

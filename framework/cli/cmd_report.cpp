@@ -4,6 +4,7 @@
 #include "core/output_folder.hpp"
 #include "report/html_report.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -15,6 +16,12 @@ struct ReportArgs {
 };
 
 int report(const ReportArgs &args) {
+    // --output names the report's file: never a folder, whose other files a report would
+    // sit among (and an existing report.html in it would be replaced).
+    std::error_code ec;
+    if (!args.output.empty() && (args.output.back() == '/' || std::filesystem::is_directory(args.output, ec)))
+        throw UsageError("--output " + args.output + ": is a folder; expected the report's file name (e.g. " +
+                         (std::filesystem::path(args.output) / "report.html").string() + ")");
     const std::vector<std::string> dirs = report::experimentFolders(args.dir);
     if (!args.output.empty() && dirs.size() > 1)
         throw UsageError("--output " + args.output + ": " + args.dir + " holds " + std::to_string(dirs.size()) +
@@ -39,7 +46,7 @@ Register reportCommand{{"report", "an experiment's results as one self-contained
               define<ReportArgs>(
                   [](CLI::App &app, ReportArgs &args) {
                       app.add_option("dir", args.dir, "the experiment's output folder")->type_name("DIR")->required();
-                      app.add_option("--output", args.output, "where to write (one experiment only; default DIR/report.html; a folder: report.html in it)")
+                      app.add_option("--output", args.output, "the report's file (one experiment only; default DIR/report.html; not a folder)")
                           ->type_name("FILE");
                   },
                   report)}};

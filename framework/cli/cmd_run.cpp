@@ -85,7 +85,8 @@ Register runCommand{{"run", "run a rig: disparity, cloud in ground coordinates, 
                                    "also write DIR/bag, a rosbag2 MCAP bag: rectified images, DisparityImage, PointCloud2 "
                                    "in the ground frame, figures (docs/ros2.md)");
                       app.add_option("--ros-namespace", args.rosbag.ros_namespace, "--mcap: the topics' namespace (default /binocle)")
-                          ->type_name("NS");
+                          ->type_name("NS")
+                          ->check(CLI::Validator(rosNamespaceRefusal, "NS"));
                   },
                   runRig)}};
 

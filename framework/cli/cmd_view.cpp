@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `binocle view RIG.yaml`: the rig's pipeline with a live web page on this machine.
 #include "cli/command.hpp"
+#include "core/output_folder.hpp"
 #include "input/text.hpp"
 #include "viewer/viewer.hpp"
 #include "viewer/web_guard.hpp"
@@ -18,6 +19,7 @@ struct ViewArgs {
     RigArgs rig;
     viewer::ViewOptions options;
     int64_t frames = -1;
+    bool force = false;
 };
 
 // --bind and --allow-remote are read here, before any plugin opens: a mistake in them is
@@ -35,6 +37,10 @@ int view(ViewArgs &args) {
     checkBind(o);
     o.rig_file = args.rig.file;
     o.max_frames = args.frames;
+    // --out is the view's while it runs (snapshots are a run's outputs, by name: written
+    // into a run's folder they would replace its frames); made again, and gone when no
+    // snapshot was taken.
+    const OutputFolder folder(o.out_dir, OutputClaim{OutputKind::View, args.force, "binocle view"});
     PluginHost host;
     host.scan();
     viewer::ViewSummary s;
@@ -86,6 +92,7 @@ Register viewCommand{{"view", "a live web page of a rig: images, disparity, dens
                                      "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
                           ->type_name("NAME");
                       app.add_option("--out", args.options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
+                      app.add_flag("--force", args.force, "replace what --out holds when another command (or you) wrote it");
                       addNumber(app, "--display-fps", args.options.display_fps,
                                 "most frames per second sent to browsers (each gets no more than it can draw)", "F", positiveNumber())
                           ->capture_default_str();

@@ -115,8 +115,12 @@ std::string flowText(const YAML::Node &n) {
 sdk::SettingValue readScalar(const binocle_param_desc &d, const YAML::Node &n, const Context &ctx,
                              const std::string &path) {
     sdk::SettingValue v;
-    const sdk::SettingProblem why =
-        n.IsScalar() ? sdk::readSetting(d, n.Scalar(), v) : sdk::SettingProblem{"is not a scalar", sdk::settingExpects(d)};
+    // An empty value (`key:`, `--set key=`, null, ~) is the empty text: the checker takes it
+    // where a setting accepts it (a string, a path) and refuses it everywhere else; it
+    // never stands for the plugin's default.
+    const sdk::SettingProblem why = n.IsScalar() ? sdk::readSetting(d, n.Scalar(), v)
+                                    : n.IsNull() ? sdk::readSetting(d, "", v)
+                                                 : sdk::SettingProblem{"is not a scalar", sdk::settingExpects(d)};
     if (why) {
         const std::string hint =
             d.type == BINOCLE_PARAM_ENUM && n.IsScalar() ? input::nearestWord(n.Scalar(), sdk::settingChoices(d)) : "";
@@ -212,7 +216,9 @@ ParamValues resolveWith(const PluginRecord &record, const YAML::Node &block, con
     for (const auto &d : descs) {
         const std::string path = where + "." + d.name;
         YAML::Node n = block.IsMap() ? block[d.name] : YAML::Node();
-        if (n.IsDefined() && !n.IsNull()) {
+        // A key given with no value is given: checked as the empty text (readScalar), not
+        // the default. A YAML setting's null is a value of its own.
+        if (n.IsDefined()) {
             setValue(values, d, n, true, ctx, path);
         } else if (d.flags & BINOCLE_PARAM_FLAG_REQUIRED || !d.default_value) {
             ctx.fail(block, where, "missing key '" + std::string(d.name) + "' for plugin '" + record.name + "'" +
@@ -270,7 +276,7 @@ RuntimeOptions runtimeBlock(const YAML::Node &r, const Context &ctx) {
         ctx.raise(ctx.at(unknown->key, "runtime." + unknown->name), "runtime: " + unknown->message);
     auto read = [&](const binocle_param_desc &d) -> std::optional<sdk::SettingValue> {
         YAML::Node n = r[d.name];
-        if (!n || n.IsNull()) return std::nullopt;
+        if (!n) return std::nullopt; // a key given with no value is refused, as in a plugin block
         return readScalar(d, n, ctx, std::string("runtime.") + d.name);
     };
     if (auto p = read(kRuntimeKeys[0]))

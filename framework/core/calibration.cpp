@@ -179,6 +179,51 @@ void checkCameraMatrix(const cv::Mat &M, const char *key, cv::Size size, const s
                         std::to_string(size.width) + "x" + std::to_string(size.height) + " image)");
 }
 
+// A calibration whose lens distortion cannot be undone (k1 = 1e6) gives rectified images
+// that show next to nothing of the camera's (a few pixels at its centre, magnified, or
+// nothing at all): a run would give 0 points and exit 0. Rays through a grid over each
+// rectified image are taken back through R_i, M_i and D_i (what the rectification maps
+// sample): at least half of them must land on the camera's image, spanning at least a
+// quarter of its width and of its height.
+void checkRectifiable(const StereoCalibration &c, const std::string &origin) {
+    if (c.rectified) return;
+    constexpr int kGrid = 9;
+    const int w = c.image_size.width, h = c.image_size.height;
+    for (int side = 0; side < 2; ++side) {
+        const cv::Mat &M = side ? c.M2 : c.M1, &D = side ? c.D2 : c.D1, &Rs = side ? c.R2 : c.R1, &P = side ? c.P2 : c.P1;
+        const cv::Matx33d back = cv::Matx33d(Rs).t();
+        std::vector<cv::Point3d> rays;
+        for (int j = 0; j < kGrid; ++j)
+            for (int i = 0; i < kGrid; ++i) {
+                const double x = ((i + 0.5) * w / kGrid - P.at<double>(0, 2)) / P.at<double>(0, 0);
+                const double y = ((j + 0.5) * h / kGrid - P.at<double>(1, 2)) / P.at<double>(1, 1);
+                rays.emplace_back(back * cv::Vec3d(x, y, 1));
+            }
+        std::vector<cv::Point2d> at;
+        cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), M, D, at);
+        int inside = 0;
+        double x0 = w, x1 = 0, y0 = h, y1 = 0;
+        for (size_t k = 0; k < at.size(); ++k)
+            if (rays[k].z > 0 && at[k].x >= 0 && at[k].x < w && at[k].y >= 0 && at[k].y < h) {
+                ++inside;
+                x0 = std::min(x0, at[k].x), x1 = std::max(x1, at[k].x), y0 = std::min(y0, at[k].y), y1 = std::max(y1, at[k].y);
+            }
+        // The samples span (kGrid - 1) / kGrid of the rectified image.
+        const double full = (kGrid - 1.0) / kGrid;
+        const double shownX = inside ? (x1 - x0) / (full * w) : 0, shownY = inside ? (y1 - y0) / (full * h) : 0;
+        if (2 * inside >= kGrid * kGrid && shownX >= 0.25 && shownY >= 0.25) continue;
+        std::ostringstream d;
+        for (int k = 0; k < static_cast<int>(D.total()); ++k) d << (k ? ", " : "") << number(D.at<double>(k));
+        const char *m = side ? "M2" : "M1", *dk = side ? "D2" : "D1";
+        throw Error(origin + ": calibration keys '" + m + "' and '" + dk + "' (" + dk + " = [" + d.str() +
+                    "]) cannot be rectified: the rectified " + (side ? "right" : "left") + " image would show " +
+                    number(std::round(shownX * 1000) / 10) + " % of the width and " + number(std::round(shownY * 1000) / 10) +
+                    " % of the height of the " + std::to_string(w) + "x" + std::to_string(h) + " camera image (" +
+                    std::to_string(inside) + " of " + std::to_string(kGrid * kGrid) +
+                    " sampled points on it); expected a lens distortion that can be undone (at least a quarter of each)");
+    }
+}
+
 } // namespace
 
 void StereoCalibration::validate(const std::string &origin) const {
@@ -198,7 +243,8 @@ void StereoCalibration::validate(const std::string &origin) const {
                     number(kMinBaselineMm) + ".." + number(kMaxBaselineMm) + " mm");
 }
 
-StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &origin) {
+StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std::string &originText) {
+    std::string origin = originText;
     // OpenCV writes "%YAML:1.0" as its first line; that is not a YAML 1.2 directive, so it
     // is blanked (lines and columns stay) before the strict parse; the rest of its line is not.
     std::string yaml = text;
@@ -213,11 +259,15 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
     }
     if (!root.IsMap())
         throw Error(origin + ": not a calibration: expected a map of keys (image_width, image_height, M1, D1, M2, D2, R, T)");
+    // Where a published calibration came from (replay: the bag and its CameraInfo topics):
+    // every message below names it.
+    if (const YAML::Node from = root["source"]; from && from.IsScalar())
+        origin += " (" + input::printable(from.Scalar(), 400) + ")";
     // The keys written by toYaml() (R1 ... Q, baseline_mm and focal_length_px are derived:
     // read again from M1 ... T, not from the file); any other key is a mistake.
     if (const auto unknown = input::findUnknownKey(root, {"image_width", "image_height", "configuration", "rectified", "M1", "D1",
                                                           "M2", "D2", "R", "T", "R1", "R2", "P1", "P2", "Q", "baseline_mm",
-                                                          "focal_length_px", "rms_px"},
+                                                          "focal_length_px", "rms_px", "source"},
                                                    "in a calibration"))
         throw Error(input::located(unknown->key, origin) + ": " + unknown->message);
     StereoCalibration c;
@@ -250,6 +300,7 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
         }
         c.validate(origin);
         c.computeRectification();
+        checkRectifiable(c, origin);
     } catch (const cv::Exception &e) {
         throw Error(origin + ": calibration cannot be used: " + e.err);
     }

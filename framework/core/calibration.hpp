@@ -10,6 +10,8 @@
 //   rectified                   int     1: images are already rectified (R1 = R2 = I)
 //   R1, R2, P1, P2, Q           matrix  rectification (written; recomputed on load)
 //   baseline_mm, focal_length_px, rms_px, configuration   informative
+//   source                      text    where a published calibration came from (a bag and
+//                                       its topics): named in every refusal of it
 // Written with FileStorage; read with the strict YAML loader (FileStorage's parser does
 // not return on some mangled files): any other key, a second document, a duplicate key
 // or a number that is not plain decimal is refused with its line and column.

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 
@@ -36,6 +37,33 @@ public:
 
 private:
     std::string program_;
+};
+
+// "%~" in a pattern: the message with its control characters escaped (\x1b, and the C1
+// controls U+0080..U+009F as \u0080). The one place every logged text passes, so a name
+// from a file (a bag's topic, a plugin's message) can never drive the terminal: move the
+// cursor, retitle the window or hide a line. Line breaks and tabs stay as they are.
+class EscapedMessage : public spdlog::custom_flag_formatter {
+public:
+    void format(const spdlog::details::log_msg &msg, const std::tm &, spdlog::memory_buf_t &dest) override {
+        const char *p = msg.payload.data();
+        const size_t n = msg.payload.size();
+        char hex[8];
+        for (size_t i = 0; i < n; ++i) {
+            const auto c = static_cast<unsigned char>(p[i]);
+            if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
+                std::snprintf(hex, sizeof hex, "\\x%02x", c);
+                dest.append(hex, hex + 4);
+            } else if (c == 0xc2 && i + 1 < n && static_cast<unsigned char>(p[i + 1]) >= 0x80 &&
+                       static_cast<unsigned char>(p[i + 1]) <= 0x9f) {
+                std::snprintf(hex, sizeof hex, "\\u%04x", static_cast<unsigned char>(p[++i]));
+                dest.append(hex, hex + 6);
+            } else {
+                dest.push_back(static_cast<char>(c));
+            }
+        }
+    }
+    std::unique_ptr<custom_flag_formatter> clone() const override { return std::make_unique<EscapedMessage>(); }
 };
 
 // stderr, clearing a live progress line first so that a message never lands in its middle.
@@ -66,13 +94,15 @@ spdlog::level::level_enum parseLogLevel(const std::string &text, const std::stri
 void setupLogging(const LogOptions &options) {
     auto console = std::make_shared<StderrSink>();
     auto consoleFormat = std::make_unique<spdlog::pattern_formatter>();
-    consoleFormat->add_flag<LevelPrefix>('*', options.program).set_pattern("%*%v");
+    consoleFormat->add_flag<LevelPrefix>('*', options.program).add_flag<EscapedMessage>('~').set_pattern("%*%~");
     console->set_formatter(std::move(consoleFormat));
     std::vector<spdlog::sink_ptr> sinks{console};
     if (!options.file.empty()) {
         try {
             auto file = std::make_shared<spdlog::sinks::basic_file_sink_mt>(options.file);
-            file->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %v");
+            auto fileFormat = std::make_unique<spdlog::pattern_formatter>();
+            fileFormat->add_flag<EscapedMessage>('~').set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %~");
+            file->set_formatter(std::move(fileFormat));
             sinks.push_back(file);
         } catch (const spdlog::spdlog_ex &e) {
             throw Error("--log-file " + options.file + ": cannot open it: " + e.what());

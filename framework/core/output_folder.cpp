@@ -2,8 +2,10 @@
 // Output-folder ownership: a lock file held with flock, and the kind of output a folder holds.
 #include "core/output_folder.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
@@ -40,25 +42,92 @@ std::string ownerOf(int fd) {
     return "process " + pid + (command.empty() ? "" : " (" + command + ")");
 }
 
+struct KindName {
+    OutputKind kind;
+    const char *name, *what;
+};
+constexpr KindName kKinds[] = {{OutputKind::Run, "run", "the output of a run"},
+                               {OutputKind::Recording, "recording", "a recording"},
+                               {OutputKind::Experiment, "experiment", "an experiment's results"},
+                               {OutputKind::Design, "design", "a design's ranking"},
+                               {OutputKind::View, "view", "the viewer's snapshots"}};
+
+// The marker's kind and command; kind None when there is no marker (or not one of ours).
+std::pair<OutputKind, std::string> markerOf(const fs::path &dir) {
+    const fs::path marker = dir / OutputFolder::kMarkerFile;
+    if (!isFile(marker)) return {OutputKind::None, ""};
+    char buf[256] = {};
+    const int fd = ::open(marker.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) return {OutputKind::None, ""};
+    const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+    ::close(fd);
+    std::string text(buf, n > 0 ? static_cast<size_t>(n) : 0);
+    text = text.substr(0, text.find('\n'));
+    const size_t space = text.find(' ');
+    const std::string name = text.substr(0, space);
+    std::string command = space == std::string::npos ? "" : text.substr(space + 1);
+    for (char &c : command)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+    for (const KindName &k : kKinds)
+        if (name == k.name) return {k.kind, command};
+    return {OutputKind::None, ""};
+}
+
+// Recognised by the files each command writes first (folders made before the marker).
+std::pair<OutputKind, std::string> recognised(const fs::path &d) {
+    // A recording first: it is the one a user can least afford to lose.
+    if (isFile(d / "frames.csv")) return {OutputKind::Recording, "frames.csv"};
+    if (isFile(d / "metadata.yaml")) return {OutputKind::Recording, "a rosbag2 bag: metadata.yaml"};
+    std::error_code ec;
+    for (const auto &e : fs::directory_iterator(d, ec))
+        if (e.path().extension() == ".mcap") return {OutputKind::Recording, "an MCAP file: " + e.path().filename().string()};
+    if (isFile(d / "results.json")) return {OutputKind::Experiment, "results.json"};
+    if (isFile(d / "results.csv")) return {OutputKind::Experiment, "results.csv"};
+    if (isFile(d / "frames.jsonl")) return {OutputKind::Run, "frames.jsonl"};
+    if (isFile(d / "design.json")) return {OutputKind::Design, "design.json"};
+    return {OutputKind::None, ""};
+}
+
 } // namespace
 
 std::string describe(OutputKind kind) {
-    switch (kind) {
-    case OutputKind::None: return "nothing Binocle wrote";
-    case OutputKind::Run: return "the output of a run (frames.jsonl)";
-    case OutputKind::Recording: return "a recording (frames.csv)";
-    case OutputKind::Experiment: return "an experiment's results (results.json)";
-    }
-    return "?";
+    for (const KindName &k : kKinds)
+        if (k.kind == kind) return k.what;
+    return "nothing Binocle wrote";
 }
 
 OutputKind outputKindOf(const std::string &dir) {
-    const fs::path d(dir);
-    // A recording first: it is the one a user can least afford to lose.
-    if (isFile(d / "frames.csv")) return OutputKind::Recording;
-    if (isFile(d / "results.json") || isFile(d / "results.csv")) return OutputKind::Experiment;
-    if (isFile(d / "frames.jsonl")) return OutputKind::Run;
-    return OutputKind::None;
+    const auto marked = markerOf(dir);
+    return marked.first != OutputKind::None ? marked.first : recognised(dir).first;
+}
+
+std::vector<std::string> entriesOf(const std::string &dir) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto &e : fs::directory_iterator(dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name != OutputFolder::kLockFile && name != OutputFolder::kMarkerFile) names.push_back(name);
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string listEntries(const std::string &dir, size_t max) {
+    const std::vector<std::string> names = entriesOf(dir);
+    std::string out;
+    for (size_t i = 0; i < names.size() && i < max; ++i) out += (i ? ", " : "") + names[i];
+    if (names.size() > max) out += ", ... (" + std::to_string(names.size()) + " entries)";
+    return out;
+}
+
+std::string describeContent(const std::string &dir) {
+    if (entriesOf(dir).empty()) return "";
+    const auto [marked, command] = markerOf(dir);
+    const auto [kind, file] = recognised(dir);
+    if (marked != OutputKind::None)
+        return describe(marked) + (kind == marked ? " (" + file + ")" : "") + ", made by " + (command.empty() ? "binocle" : command);
+    if (kind != OutputKind::None) return describe(kind) + " (" + file + ")";
+    return "files Binocle did not write there (" + listEntries(dir) + ")";
 }
 
 OutputFolder::OutputFolder(const std::string &dir, const OutputClaim &claim) : dir_(dir) {
@@ -67,7 +136,13 @@ OutputFolder::OutputFolder(const std::string &dir, const OutputClaim &claim) : d
     const auto status = fs::symlink_status(dir, ec);
     if (fs::exists(status) && !fs::is_directory(fs::status(dir, ec)))
         throw Error("output folder " + dir + ": exists and is not a folder");
-    created_ = !fs::exists(status);
+    // The folders this claim makes (DIR and any missing parent), deepest first.
+    fs::path deepest = fs::path(dir).lexically_normal();
+    if (deepest.filename().empty()) deepest = deepest.parent_path(); // "out/view/"
+    for (fs::path p = deepest; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+        created_.push_back(p.string());
+        if (p == p.parent_path()) break;
+    }
     fs::create_directories(dir, ec);
     if (ec) throw Error("output folder " + dir + ": cannot create the folder: " + ec.message());
     lock(claim.command);
@@ -81,20 +156,36 @@ OutputFolder::OutputFolder(const std::string &dir, const OutputClaim &claim) : d
 
 void OutputFolder::checkKind(const OutputClaim &claim) {
     const std::string &dir = dir_;
-    std::error_code ec;
-    const OutputKind held = outputKindOf(dir);
-    if (claim.kind == OutputKind::None || held == OutputKind::None || held == claim.kind) return;
-    if (!claim.force) {
-        throw Error("output folder " + dir + " holds " + describe(held) + ": refusing to write " + describe(claim.kind) +
-                    " into it; choose another folder, or pass --force to replace what it holds");
+    if (claim.kind == OutputKind::None) return;
+    if (entriesOf(dir).empty() || markerOf(dir).first == claim.kind) return mark(claim);
+    const std::string held = describeContent(dir);
+    // Python's functions take force=True where the command line takes --force.
+    const bool python = claim.command.rfind("binocle.", 0) == 0;
+    const std::string flag = python ? "force=True" : "--force";
+    // A recording is never written over: `binocle record` has no --force.
+    const bool recording = claim.kind == OutputKind::Recording;
+    if (!claim.force || recording) {
+        throw Error("output folder " + dir + " holds " + held + ": " + (claim.command.empty() ? "binocle" : claim.command) +
+                    " writes " + describe(claim.kind) + " only into a new or empty folder" +
+                    (recording ? "; choose another folder" : ", or one it made; choose another folder, or pass " + flag +
+                                                                 " to replace what it holds"));
     }
     // Replace: everything but the lock goes; entries are removed, never followed.
+    std::error_code ec;
     for (const auto &e : fs::directory_iterator(dir, ec)) {
         if (e.path().filename() == kLockFile) continue;
         fs::remove_all(e.path(), ec);
-        if (ec) throw Error("output folder " + dir + ": --force: cannot remove " + e.path().string() + ": " + ec.message());
+        if (ec) throw Error("output folder " + dir + ": " + flag + ": cannot remove " + e.path().string() + ": " + ec.message());
     }
     if (ec) throw Error("output folder " + dir + ": cannot list the folder: " + ec.message());
+    mark(claim);
+}
+
+void OutputFolder::mark(const OutputClaim &claim) {
+    for (const KindName &k : kKinds)
+        if (k.kind == claim.kind && markerOf(dir_).first != claim.kind)
+            writeFileAtomic((fs::path(dir_) / kMarkerFile).string(),
+                            std::string(k.name) + " " + (claim.command.empty() ? "binocle" : claim.command) + "\n");
 }
 
 void OutputFolder::lock(const std::string &command) {
@@ -144,8 +235,13 @@ void OutputFolder::release() {
     ::close(fd_);
     fd_ = -1;
     // A folder this claim made and nothing was written into (the command was refused
-    // before its first output) goes again; rmdir leaves any folder that holds something.
-    if (created_) ::rmdir(dir_.c_str());
+    // before its first output) goes again, marker and all; rmdir leaves any folder that
+    // holds something.
+    if (!created_.empty() && entriesOf(dir_).empty()) {
+        ::unlink((fs::path(dir_) / kMarkerFile).c_str());
+        for (const std::string &d : created_)
+            if (::rmdir(d.c_str()) != 0) break;
+    }
 }
 
 } // namespace binocle

@@ -331,6 +331,9 @@ bool inspectImage(const uint8_t *data, size_t size, ImageInfo &info, std::string
     info = {};
     problem.clear();
     static const uint8_t kPng[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+    // Checked here, the one entry every image passes before a decoder sees it: OpenCV
+    // answers an empty buffer with an assertion ("!buf.empty()").
+    if (size == 0) return fail(problem, "it is empty (0 bytes); expected an image (PNG, JPEG, PGM/PPM, PFM or BMP)");
     if (size > static_cast<uint64_t>(limits.maxFileBytes))
         return fail(problem, "the file holds " + std::to_string(size) + " bytes; the limit is " +
                                  std::to_string(limits.maxFileBytes));

@@ -4,6 +4,7 @@
 
 #include "input/text.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
 
 #include <algorithm>
@@ -108,6 +109,10 @@ YAML::Node parseYaml(const std::string &text, const std::string &origin) {
         // stray tokens after a document it loops for ever, allocating (found by fuzzing).
         if (const auto second = secondDocument(text))
             throw YamlError(at(origin, *second) + ": more follows the first YAML document here; expected one document");
+    } catch (const YAML::DeepRecursion &e) {
+        // yaml-cpp's own guard (500 levels), which it words "bad file".
+        throw YamlError(at(origin, e.mark) + ": lists or maps nested more than " + std::to_string(e.depth()) +
+                        " deep; expected a YAML file nested a few levels (no Binocle file needs more than ten)");
     } catch (const YAML::ParserException &e) {
         throw YamlError(at(origin, e.mark) + ": YAML syntax error: " + e.msg);
     } catch (const YAML::Exception &e) {

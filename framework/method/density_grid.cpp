@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace binocle::method {
 
@@ -51,6 +52,12 @@ void GridSpec::validate() const {
     checkExtent(x, "X");
     checkExtent(y, "Y");
     checkExtent(z, "Z");
+    // A cell larger than an extent leaves that axis without a cell (1e300 mm: 0 cells, and
+    // every view an empty image).
+    for (const auto &[e, name] : {std::pair<const Extent *, const char *>{&x, "X"}, {&y, "Y"}, {&z, "Z"}})
+        if (cell_mm > e->size())
+            throw std::invalid_argument("cell size " + number(cell_mm) + " mm is larger than the grid's " + name + " extent (" +
+                                        number(e->size()) + " mm): expected a cell no larger than the smallest extent");
     // Counted in doubles before any cast to int (4.3e11 mm / 100 mm overflows an int), for
     // each of the three views: every axis has at least one cell, so each count bounds its
     // axes too.

@@ -26,6 +26,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <sys/resource.h>
+#include <unistd.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
@@ -236,6 +238,27 @@ void Pipeline::checkFrameSize(const LentFrame &frame, int64_t ordinal) const {
                 sizeText(imageSize_) + " as the frames before it and the calibration (" +
                 (rig_.calibration_file ? *rig_.calibration_file : "published by the source") +
                 "): refusing to process it with the wrong geometry (did the source change its image size mid-run?)");
+}
+
+// Up to runtime.queue_depth frames wait at the source: when frames of this size cannot all
+// fit in memory, the run would die in whatever allocation comes first (an image decode, a
+// copy), far from its cause. Refused at the first frame, naming the key and what fits.
+void Pipeline::checkQueueMemory(const LentFrame &frame) const {
+    const auto bytesOf = [](const cv::Mat &m) { return static_cast<double>(m.total() * m.elemSize()); };
+    const double pair = bytesOf(frame.left()) + bytesOf(frame.right());
+    const int depth = rig_.runtime.queue_depth;
+    double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+    for (const int limit : {RLIMIT_AS, RLIMIT_DATA})
+        if (struct rlimit r {}; ::getrlimit(limit, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
+            memory = std::min(memory, static_cast<double>(r.rlim_cur));
+    // Half of it: the stages, the plugins and the outputs need the rest.
+    if (!(memory > 0) || pair * depth <= memory / 2) return;
+    auto mb = [](double b) { return std::to_string(static_cast<int64_t>(std::ceil(b / (1 << 20)))); };
+    const auto fits = static_cast<int64_t>(std::floor(memory / 2 / pair));
+    throw Error("runtime.queue_depth " + std::to_string(depth) + ": up to " + std::to_string(depth) + " frames of " +
+                sizeText(frame.left().size()) + " (" + mb(pair) + " MB a pair) may wait at the source, " + mb(pair * depth) +
+                " MB in all; this process may use " + mb(memory) + " MB (memory, or ulimit -v): expected a queue_depth of at most " +
+                std::to_string(std::max<int64_t>(1, fits)) + " for frames this large");
 }
 
 Json Pipeline::run(const RunOptions &options, const std::function<void(const FrameResult &)> &onFrame) {

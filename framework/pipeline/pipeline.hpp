@@ -144,6 +144,8 @@ private:
     void write(RunState &s, const std::function<void(const FrameResult &)> &onFrame);
     std::string finishSummary(RunState &s, nlohmann::ordered_json &summary, double elapsed);
     void checkFrameSize(const LentFrame &frame, int64_t ordinal) const;
+    // runtime.queue_depth frames of the first frame's size must fit in memory.
+    void checkQueueMemory(const LentFrame &frame) const;
     void refreshSourceStatistics();
     std::unique_ptr<EvaluatorSlot> makeEvaluator(const PluginBlock &block);
 

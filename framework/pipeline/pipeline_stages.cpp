@@ -110,7 +110,10 @@ void Pipeline::acquire(RunState &s) {
                 break;
             }
             const double grabSeconds = secondsSince(grabStart);
-            if (!calibrationReady_) prepareCalibration(frame->left().size());
+            if (!calibrationReady_) {
+                checkQueueMemory(*frame);
+                prepareCalibration(frame->left().size());
+            }
             checkFrameSize(*frame, s.grabbed);
             if (Clock::now() - lastStatistics > std::chrono::milliseconds(500)) {
                 refreshSourceStatistics();

@@ -51,23 +51,6 @@ cv::Mat recordableView(const binocle_image &im) {
 
 namespace {
 
-// What a folder holds, but the lock of the process that owns it (core/output_folder.hpp).
-std::vector<std::string> entriesOf(const fs::path &dir) {
-    std::vector<std::string> names;
-    for (const auto &e : fs::directory_iterator(dir))
-        if (e.path().filename() != OutputFolder::kLockFile) names.push_back(e.path().filename().string());
-    return names;
-}
-
-std::string listed(const fs::path &dir) {
-    std::vector<std::string> names = entriesOf(dir);
-    std::sort(names.begin(), names.end());
-    std::string out;
-    for (size_t i = 0; i < names.size() && i < 4; ++i) out += (i ? ", " : "") + names[i];
-    if (names.size() > 4) out += ", ... (" + std::to_string(names.size()) + " entries)";
-    return out;
-}
-
 // Where a write failed, for the message: the filesystem holding `dir`, where it is
 // mounted and how much room it has left. A full disk is the usual cause and the user
 // must see which one.
@@ -306,7 +289,7 @@ RecordingWriter::RecordingWriter(const std::string &dir, const std::string &cali
     if (fs::exists(dir_, ec)) {
         if (!fs::is_directory(dir_, ec)) throw Error("record: " + dir_ + " exists and is not a folder");
         if (!entriesOf(dir_).empty())
-            throw Error("record: " + dir_ + " is not empty (it holds " + listed(dir_) +
+            throw Error("record: " + dir_ + " is not empty (it holds " + listEntries(dir_) +
                         "): refusing to record over it; choose a new folder");
     }
     fs::create_directories(fs::path(dir_) / recording::kSideFolders[0], ec);

@@ -70,7 +70,6 @@ void RosbagRecordingWriter::work() {
         busy_ = false;
         stats_.write_ms += ms;
         if (!failure.empty() && error_.empty()) error_ = failure;
-        if (failure.empty() && error_.empty()) ++written_;
         roomAvailable_.notify_all();
         drained_.notify_all();
     }
@@ -117,8 +116,9 @@ void RosbagRecordingWriter::finish() {
 }
 
 int64_t RosbagRecordingWriter::frameCount() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return written_;
+    // What a reader recovers, not what was handed to the bag: a pair in the open chunk is
+    // lost if the disk fills before the chunk is written.
+    return bag_->durablePairs();
 }
 
 RecordingWriterStats RosbagRecordingWriter::stats() const {

@@ -28,7 +28,7 @@ public:
     bool submit(const LentFrame &frame, bool wait);
     // Writes every pair submitted and closes the bag; throws the first write failure.
     void finish();
-    int64_t frameCount() const;
+    int64_t frameCount() const; // the pairs a reader recovers (RosbagWriter::durablePairs)
     RecordingWriterStats stats() const;
     const RosbagWriter &bag() const { return *bag_; }
 
@@ -46,7 +46,6 @@ private:
     std::condition_variable workAvailable_, roomAvailable_, drained_;
     std::deque<Job> todo_;
     bool busy_ = false, stopping_ = false, closed_ = false;
-    int64_t written_ = 0;
     std::string error_;
     RecordingWriterStats stats_;
     std::thread thread_;

@@ -5,9 +5,11 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
+#include "input/text.hpp"
 
 #include <binocle/ros2_messages.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -60,13 +62,39 @@ std::array<double, 9> arr9(const cv::Mat &m) {
 
 } // namespace
 
+// ROS 2's rule for a namespace (rcl's rmw_validate_namespace): "/" alone, or "/" followed
+// by tokens joined by single '/', each of letters, digits and '_' and not starting with a
+// digit; no trailing '/'; at most 255 characters. Empty when `ns` keeps it, else why not.
+std::string namespaceProblem(const std::string &ns) {
+    if (ns.empty()) return "it is empty";
+    if (ns[0] != '/') return "it does not start with '/'";
+    if (ns.size() > 255) return "it is longer than 255 characters";
+    if (ns == "/") return "";
+    if (ns.back() == '/') return "it ends with '/'";
+    size_t start = 1;
+    while (start <= ns.size()) {
+        const size_t end = std::min(ns.find('/', start), ns.size());
+        const std::string token = ns.substr(start, end - start);
+        if (token.empty()) return "it holds '//' (an empty name)";
+        if (std::isdigit(static_cast<unsigned char>(token[0]))) return "the name '" + token + "' starts with a digit";
+        if (!rosName(token, false)) return "the name '" + input::printable(token) + "' holds a character other than letters, digits and '_'";
+        start = end + 1;
+    }
+    return "";
+}
+
+std::string rosNamespaceRefusal(const std::string &ns) {
+    const std::string why = namespaceProblem(ns);
+    if (why.empty()) return "";
+    return "'" + input::printable(ns) + "': " + why + "; ROS 2 expects '/' followed by names of letters, digits and '_' "
+           "that do not start with a digit, joined by single '/' (e.g. /vehicle/stereo)";
+}
+
 void checkRosbagOptions(const RosbagOptions &o) {
-    const std::string &ns = o.ros_namespace;
-    if (ns.empty() || ns[0] != '/' || (ns.size() > 1 && (!rosName(ns.substr(1), true) || ns.back() == '/')))
-        throw Error("--ros-namespace '" + ns + "': expected '/' followed by names of letters, digits and '_' (e.g. /vehicle/stereo)");
+    if (const std::string why = rosNamespaceRefusal(o.ros_namespace); !why.empty()) throw Error("--ros-namespace " + why);
     for (const auto *f : {&o.frame_id_left, &o.frame_id_right, &o.frame_id_ground})
         if (!rosName(*f, true))
-            throw Error("frame id '" + *f + "': expected letters, digits, '_' and '/' (e.g. stereo_left_optical)");
+            throw Error("frame id '" + input::printable(*f) + "': expected letters, digits, '_' and '/' (e.g. stereo_left_optical)");
 }
 
 RosbagWriter::RosbagWriter(const std::string &dir, const std::optional<StereoCalibration> &calibration,
@@ -74,13 +102,9 @@ RosbagWriter::RosbagWriter(const std::string &dir, const std::optional<StereoCal
     : dir_(dir), options_(options), calibration_(calibration) {
     checkRosbagOptions(options_);
     std::error_code ec;
-    if (fs::exists(dir, ec)) {
-        bool empty = fs::is_directory(dir, ec);
-        // The lock of `binocle record`/`run` (core/output_folder.hpp) is not content.
-        for (const auto &e : fs::directory_iterator(dir, ec))
-            if (e.path().filename() != OutputFolder::kLockFile) empty = false;
-        if (!empty) throw Error("rosbag: '" + dir + "' exists and is not an empty folder; a bag is never written over anything");
-    }
+    // The lock and marker of `binocle record`/`run` (core/output_folder.hpp) are not content.
+    if (fs::exists(dir, ec) && (!fs::is_directory(dir, ec) || !entriesOf(dir).empty()))
+        throw Error("rosbag: '" + dir + "' exists and is not an empty folder; a bag is never written over anything");
     fs::create_directories(dir, ec);
     if (ec) throw Error("rosbag: cannot create folder '" + dir + "': " + ec.message());
     std::string name = fs::path(dir).lexically_normal().filename().string();
@@ -162,6 +186,17 @@ void RosbagWriter::writePair(int64_t stampLeftNs, int64_t stampRightNs, const cv
             write(sideNs + "camera_info", ros2::CameraInfo::kType, stamp, ros2::encode(info));
         }
     }
+    pairEnds_.push_back(writer_->statistics().message_count);
+}
+
+int64_t RosbagWriter::durablePairs() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const uint64_t durable = writer_->durableMessageCount();
+    while (!pairEnds_.empty() && pairEnds_.front() <= durable) {
+        pairEnds_.pop_front();
+        ++durablePairs_;
+    }
+    return durablePairs_;
 }
 
 void RosbagWriter::writeDisparity(int64_t stampNs, const cv::Mat &disparity, double focalLengthPx, double baselineM,

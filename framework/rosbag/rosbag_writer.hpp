@@ -19,6 +19,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -37,9 +38,14 @@ struct RosbagOptions {
     int compression_level = 1;
 };
 
-// Refuses what ROS would: a namespace that is not "/" followed by [A-Za-z0-9_/] names, a
-// frame id with spaces. Throws binocle::Error naming the option and the value.
+// Refuses what ROS would: a namespace that breaks ROS 2's rule (rcl's namespace
+// validation: "/" alone, or "/"-joined names of [A-Za-z0-9_] not starting with a digit, no
+// "//", no trailing "/"), a frame id with spaces. Throws binocle::Error naming the option
+// and the value.
 void checkRosbagOptions(const RosbagOptions &options);
+// Why `ns` is not a ROS 2 namespace ("'//x': it holds '//' ...; ROS 2 expects ..."), or
+// empty: what --ros-namespace's validator answers.
+std::string rosNamespaceRefusal(const std::string &ns);
 
 class RosbagWriter {
 public:
@@ -72,6 +78,10 @@ public:
     const std::string &file() const { return file_; }
     uint64_t messageCount() const;
     uint64_t bytesWritten() const;
+    // The pairs (writePair calls) a reader of the bag recovers whole: those whose every
+    // message lies in a chunk written whole (mcap::Writer::durableMessageCount). What a
+    // recording may claim, on a full disk too.
+    int64_t durablePairs();
 
 private:
     uint16_t channel(const std::string &topic, const char *type);
@@ -85,6 +95,8 @@ private:
     std::optional<StereoCalibration> calibration_;
     std::map<std::string, std::pair<uint16_t, std::string>> channels_; // topic -> id, type
     std::map<std::string, uint64_t> counts_;
+    std::deque<uint64_t> pairEnds_; // the message count after each pair not yet durable
+    int64_t durablePairs_ = 0;
     uint32_t sequence_ = 0;
     int64_t first_ = INT64_MAX, last_ = INT64_MIN;
     bool closed_ = false;

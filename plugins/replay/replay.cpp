@@ -388,6 +388,11 @@ Plan planRecording(const Settings &s, const sdk::Host &host) {
             if (!fs::is_regular_file(*p))
                 throw Error(BINOCLE_ERR_NOT_FOUND, "replay: " + where + ":" + std::to_string(lineOf[i]) + " names " +
                                                        inQuotes(*p) + ", which does not exist");
+            else if (const std::string out = recording::outsideOf(folder, *p); !out.empty())
+                throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "replay: " + where + ":" + std::to_string(lineOf[i]) + " names " +
+                                                              inQuotes(*p) + ", which leads out of the recording to " +
+                                                              inQuotes(out) + " (a symbolic link); expected the images inside " +
+                                                              inQuotes(folder));
     if (plan.frames.empty())
         throw Error(BINOCLE_ERR_NOT_FOUND, "replay: recording " + inQuotes(folder) + " holds no complete frame");
 

@@ -12,10 +12,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <sys/stat.h>
 
 namespace fs = std::filesystem;
 
@@ -50,6 +52,18 @@ bool isCompressedType(const std::string &name) {
 } // namespace
 
 cv::Mat imageToMat(const ros2::Image &image, bool gray, const std::string &where) {
+    // The encodings read below, named in the refusal (the SDK's layout check knows more:
+    // 32FC1 and 16UC3 are images, but not a camera's).
+    static const char *const kCameraEncodings[] = {"mono8",  "mono16", "8UC1",  "16UC1", "rgb8", "bgr8",
+                                                   "8UC3",   "rgba8",  "bgra8", "8UC4"};
+    const bool known = std::find_if(std::begin(kCameraEncodings), std::end(kCameraEncodings),
+                                    [&](const char *e) { return image.encoding == e; }) != std::end(kCameraEncodings) ||
+                       (image.encoding.rfind("bayer_", 0) == 0 && ros2::Image::bytesPerPixel(image.encoding) > 0);
+    if (!known)
+        refuse(BINOCLE_ERR_INVALID_ARGUMENT, where + ": encoding " + quoteText(image.encoding) +
+                                                 " is not a camera image encoding replay reads; expected mono8, mono16, "
+                                                 "rgb8, bgr8, rgba8, bgra8, 8UC1, 16UC1, 8UC3, 8UC4 or bayer_<pattern>8/16 "
+                                                 "(e.g. bayer_rggb8)");
     try {
         image.checkLayout(where);
     } catch (const ros2::Error &e) {
@@ -69,13 +83,18 @@ cv::Mat imageToMat(const ros2::Image &image, bool gray, const std::string &where
     if (sixteen) type = CV_16UC1;
     else if (bpp == 3) type = CV_8UC3;
     else if (bpp == 4 && e != "32FC1") type = CV_8UC4;
-    else if (e == "32FC1" || e == "16UC3")
-        refuse(BINOCLE_ERR_INVALID_ARGUMENT, where + ": encoding " + e +
-                                                 " is not a camera image; expected mono8, mono16, rgb8, bgr8, rgba8, "
-                                                 "bgra8 or bayer_*8/16");
     // A view of the message's bytes (rows `step` apart); converted below into owned pixels.
-    cv::Mat view(static_cast<int>(image.height), static_cast<int>(image.width), type, const_cast<uint8_t *>(image.data),
-                 image.step);
+    // A step that is not a whole number of samples (mono16 with an odd step: legal in ROS)
+    // cannot be viewed by OpenCV: the rows are copied together first.
+    cv::Mat view;
+    if (image.step % CV_ELEM_SIZE1(type) == 0) {
+        view = cv::Mat(static_cast<int>(image.height), static_cast<int>(image.width), type, const_cast<uint8_t *>(image.data),
+                       image.step);
+    } else {
+        view.create(static_cast<int>(image.height), static_cast<int>(image.width), type);
+        const size_t rowBytes = view.cols * view.elemSize();
+        for (int y = 0; y < view.rows; ++y) std::memcpy(view.ptr(y), image.data + size_t{image.step} * y, rowBytes);
+    }
     cv::Mat m;
     if (sixteen) {
         cv::Mat v = view;
@@ -178,6 +197,12 @@ void McapPairs::openFiles(const std::string &bag) {
                 // rosbag2 writes either "x_0.mcap" or "bagname/x_0.mcap".
                 fs::path f = fs::path(bag) / rel;
                 if (!fs::exists(f, ec)) f = fs::path(bag) / fs::path(rel).filename();
+                f = f.lexically_normal();
+                // Each file once: a file listed twice would play every pair twice.
+                if (std::find(files.begin(), files.end(), f) != files.end())
+                    refuse(BINOCLE_ERR_INVALID_ARGUMENT, "rosbag2 metadata " + quoteText(meta.string()) + " names file " +
+                                                             quoteText(rel) + " twice (as " + quoteText(f.string()) +
+                                                             "); expected each file of the bag once");
                 files.push_back(f);
             }
         } else {
@@ -189,10 +214,18 @@ void McapPairs::openFiles(const std::string &bag) {
             refuse(BINOCLE_ERR_NOT_FOUND, "bag folder " + quoteText(bag) + " holds no .mcap file (and no metadata.yaml naming one)");
     } else if (fs::is_regular_file(bag, ec)) {
         files.emplace_back(bag);
+    } else if (struct stat st {}; ::stat(bag.c_str(), &st) == 0) {
+        refuse(BINOCLE_ERR_INVALID_ARGUMENT, "bag " + quoteText(bag) + " is " + sdk::fileTypeName(st.st_mode) +
+                                                 "; expected an .mcap file or a rosbag2 folder");
     } else {
         refuse(BINOCLE_ERR_NOT_FOUND, "bag " + quoteText(bag) + " does not exist; expected an .mcap file or a rosbag2 folder");
     }
     for (const fs::path &f : files) {
+        // Never opened unless a regular file: a FIFO would block the open for ever, a
+        // device (/dev/zero) never ends. mcap::Reader refuses them too, without blocking.
+        if (struct stat st {}; ::stat(f.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+            refuse(BINOCLE_ERR_INVALID_ARGUMENT, "bag file " + quoteText(f.string()) + " is " + sdk::fileTypeName(st.st_mode) +
+                                                     "; expected a regular .mcap file");
         try {
             readers_.push_back(std::make_unique<mcap::Reader>(f.string()));
         } catch (const mcap::Error &e) {
@@ -452,6 +485,9 @@ std::string McapPairs::calibrationYaml(std::string &why) const {
     fs << "D2" << (m.D2.empty() ? cv::Mat::zeros(1, 5, CV_64F) : mat(m.D2.data(), 1, static_cast<int>(m.D2.size())));
     fs << "R" << mat(m.R.data(), 3, 3) << "T" << mat(m.T.data(), 3, 1);
     fs << "rectified" << (rectified ? 1 : 0);
+    // Named in every refusal of this calibration (core/calibration.hpp), beside its keys.
+    fs << "source" << ("bag " + sdk::printable(fileList_, 200) + ", CameraInfo topics " + sdk::printable(infoTopic[0]) + " and " +
+                       sdk::printable(infoTopic[1]));
     return fs.releaseAndGetString();
 }
 

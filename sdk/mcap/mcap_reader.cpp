@@ -4,6 +4,8 @@
 // complete chunk. Every size is checked against the file and the caps before allocating.
 #include "mcap_records.hpp"
 
+#include <binocle/text.hpp>
+
 #include <cerrno>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -138,11 +140,13 @@ struct Reader::Impl {
     // ---- Opening -------------------------------------------------------------------------
 
     void open() {
-        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        // O_NONBLOCK: a FIFO (or a device) named as the file is refused below, never waited
+        // on; on a regular file it changes nothing.
+        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
         if (fd < 0) throw Error("mcap: cannot open " + path + ": " + std::strerror(errno));
         struct stat st {};
         if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
-            throw Error("mcap: " + path + " is not a regular file; expected an MCAP file");
+            throw Error("mcap: " + path + " is not a regular file (" + sdk::fileTypeName(st.st_mode) + "); expected an MCAP file");
         size = static_cast<uint64_t>(st.st_size);
         uint8_t magic[8];
         if (size < sizeof magic + kRecordHead)

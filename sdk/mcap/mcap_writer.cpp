@@ -22,6 +22,8 @@ struct Writer::Impl {
     uint64_t offset = 0;  // bytes in the file
     uint32_t dataCrc = 0; // of everything before Data End
     bool closed = false;
+    std::string broken;           // why an earlier write failed; nothing is appended after it
+    uint64_t durableMessages = 0; // messages in chunks written whole (and fsync'ed)
 
     std::vector<Schema> schemas;
     std::vector<Channel> channels;
@@ -38,15 +40,26 @@ struct Writer::Impl {
 
     std::string where() const { return "mcap: " + path; }
 
+    // Writes the bytes whole or not at all: a write cut short (a full disk, the file size
+    // limit) is cut back off the file, so that the file ends with its last whole record and
+    // a reader recovers exactly what durableMessages counts; the writer then refuses more.
     void writeAll(const uint8_t *p, size_t n, bool data = true) {
-        if (data) dataCrc = crc32(p, n, dataCrc);
+        if (!broken.empty()) throw Error(where() + ": an earlier write failed (" + broken + "); nothing more is written");
+        const uint64_t start = offset;
+        const uint32_t crcBefore = dataCrc;
         while (n > 0) {
             const ssize_t w = ::write(fd, p, n);
             if (w < 0 && errno == EINTR) continue;
-            if (w <= 0) // write() returning 0 sets no errno
-                throw Error(where() + ": cannot write at offset " + std::to_string(offset) + ": " +
-                                (w < 0 ? std::strerror(errno) : "no byte written (is the disk full?)"),
-                            static_cast<int64_t>(offset));
+            if (w <= 0) { // write() returning 0 sets no errno
+                broken = w < 0 ? std::strerror(errno) : "no byte written (is the disk full?)";
+                const bool cut = ::ftruncate(fd, static_cast<off_t>(start)) == 0;
+                if (cut) offset = start;
+                dataCrc = crcBefore;
+                throw Error(where() + ": cannot write at offset " + std::to_string(start) + ": " + broken +
+                                (cut ? "; the file ends with its last whole record" : ""),
+                            static_cast<int64_t>(start));
+            }
+            if (data) dataCrc = crc32(p, static_cast<size_t>(w), dataCrc);
             p += w;
             n -= static_cast<size_t>(w);
             offset += static_cast<uint64_t>(w);
@@ -54,9 +67,13 @@ struct Writer::Impl {
     }
     void writeAll(const Bytes &b, bool data = true) { writeAll(b.b.data(), b.b.size(), data); }
 
-    void sync() {
-        if (options.sync_chunks && ::fsync(fd) != 0)
-            throw Error(where() + ": fsync failed: " + std::strerror(errno), static_cast<int64_t>(offset));
+    // fsync; when it fails the bytes since `start` are not known to be on disk: they are
+    // cut off, as a failed write is.
+    void sync(uint64_t start) {
+        if (!options.sync_chunks || ::fsync(fd) == 0) return;
+        broken = std::string("fsync failed: ") + std::strerror(errno);
+        if (::ftruncate(fd, static_cast<off_t>(start)) == 0) offset = start;
+        throw Error(where() + ": " + broken, static_cast<int64_t>(offset));
     }
 
     // A Schema, Channel or Statistics record (its fields: mcap_records.hpp).
@@ -114,8 +131,15 @@ struct Writer::Impl {
                 out.end(mi);
             }
         const uint64_t indexLength = out.b.size() - chunkLength;
+        const uint32_t crcBefore = dataCrc;
         writeAll(out);
-        sync();
+        try {
+            sync(chunkOffset);
+        } catch (...) {
+            dataCrc = crcBefore;
+            throw;
+        }
+        durableMessages += chunkMessages;
 
         const size_t ci = chunkIndexes.begin(Opcode::ChunkIndex);
         chunkIndexes.u64(chunkStart);
@@ -313,6 +337,7 @@ void Writer::close() {
 }
 
 const Statistics &Writer::statistics() const { return impl_->stats; }
+uint64_t Writer::durableMessageCount() const { return impl_->durableMessages; }
 uint64_t Writer::bytesWritten() const { return impl_->offset; }
 const std::string &Writer::path() const { return impl_->path; }
 

@@ -2,6 +2,8 @@
 // The bad-input corpus (tests/bad_input/<case>/): each case runs the real `binocle`
 // command on bad input and checks the exit status and the error text, that it ends
 // in time (a hang guard) and, outside sanitizer builds, within 1 GiB.
+#include "bad_bags.hpp"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
@@ -17,6 +19,7 @@
 #include <sstream>
 #include <string>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -114,6 +117,26 @@ void generate(const std::string &line, const Placeholders &ph) {
     } else if (w[0] == "copy") {
         ASSERT_EQ(w.size(), 3u) << line;
         fs::copy(w[1], w[2], fs::copy_options::recursive);
+    } else if (w[0] == "nested_yaml") { // nested_yaml PATH DEPTH: a rig whose source is lists DEPTH deep
+        ASSERT_EQ(w.size(), 3u) << line;
+        const size_t depth = std::stoul(w[2]);
+        std::ofstream(w[1], std::ios::binary) << "name: deep\nsource: " << std::string(depth, '[') << std::string(depth, ']')
+                                              << "\nmatcher: {plugin: bm}\n";
+    } else if (w[0] == "empty") { // a file of 0 bytes, its folder made
+        ASSERT_EQ(w.size(), 2u) << line;
+        fs::create_directories(fs::path(w[1]).parent_path());
+        std::ofstream(w[1], std::ios::binary);
+    } else if (w[0] == "fifo") {
+        ASSERT_EQ(w.size(), 2u) << line;
+        fs::create_directories(fs::path(w[1]).parent_path());
+        ASSERT_EQ(::mkfifo(w[1].c_str(), 0644), 0) << line;
+    } else if (w[0] == "symlink") { // symlink TARGET LINK
+        ASSERT_EQ(w.size(), 3u) << line;
+        fs::create_directories(fs::path(w[2]).parent_path());
+        fs::create_symlink(w[1], w[2]);
+    } else if (w[0] == "bag") { // bag DIR VARIANT (bad_bags.hpp)
+        ASSERT_EQ(w.size(), 3u) << line;
+        writeBadBag(w[1], w[2]);
     } else {
         FAIL() << "unknown generator: " << line;
     }
@@ -214,6 +237,8 @@ TEST_P(BadInput, ClearErrorInTimeNothingLost) {
             ADD_FAILURE() << "unknown line in expect: " << line;
         }
     }
+    // No raw terminal escape: whatever a file holds reaches the log escaped (issue 35).
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "a raw ESC in the error output";
     // No crash or sanitizer report, whatever the exit status.
     EXPECT_EQ(r.err.find("terminate called"), std::string::npos);
     EXPECT_EQ(r.err.find("Sanitizer"), std::string::npos);

@@ -102,6 +102,27 @@ TEST(CalibrateCli, ReplayRigDeliversThePairs) {
     EXPECT_TRUE(fs::exists(out.path() / "calib_B83_f534px.yml")) << r.output;
 }
 
+// Issue 35: on a full disk (an 8 KiB tmpfs in a private mount namespace; root only) the
+// calibration fails naming the disk's error, and leaves no report that reads as finished
+// beside no calibration file (it used to leave the report and the camera_info files).
+TEST(CalibrateCli, OnAFullDiskNoReportStandsWithoutItsCalibration) {
+    if (runCommand("unshare -m true").exit_code != 0) GTEST_SKIP() << "cannot make a mount namespace here (needs root)";
+    TempDir dir;
+    fs::create_directories(dir.path() / "disk");
+    const std::string disk = dir.str("disk");
+    const auto r = runCommand("BINOCLE_PLUGIN_PATH='" + std::string(BINOCLE_BUILD_PLUGIN_DIR) +
+                              "' unshare -m sh -c \"mount -t tmpfs -o size=8k tmpfs '" + disk + "' || exit 99; '" + BINOCLE_CLI +
+                              "' calibrate " BINOCLE_SOURCE_DIR "/configs/calibration/opencv-doc-stereo.yaml --board 9x6 "
+                              "--square-mm 25 --out '" + disk + "/c.yml'; echo exit=\\$?; ls -a '" + disk + "'\"");
+    if (r.exit_code == 99 || r.output.find("exit=") == std::string::npos) GTEST_SKIP() << "cannot mount a tmpfs here: " << r.output;
+    EXPECT_NE(r.output.find("exit=1"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("No space left on device"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("removed what this calibration had written before it"), std::string::npos) << r.output;
+    // What the disk held at the end (ls -a): nothing of this calibration.
+    for (const char *f : {"c_report.json", "c_left.yaml", "c_right.yaml", "c.yml"})
+        EXPECT_EQ(r.output.find(std::string("\n") + f + "\n"), std::string::npos) << f << " was left: " << r.output;
+}
+
 TEST(CalibrateCli, SimBoardCalibratesItsConfigurationAndTheRunAcceptsIt) {
     TempDir out;
     auto r = runCli("calibrate " BINOCLE_SOURCE_DIR "/configs/calibration/sim-board.yaml --board 9x6 --square-mm 25 --out " +

@@ -112,7 +112,7 @@ TEST(CalibrationReader, ReadsWhatOpenCvWritesAndSaysWhereAFileIsWrong) {
     EXPECT_EQ(readError(head + "M1: " + m + "M2: " + m + rt), "");
     EXPECT_EQ(readError(head + "rectifed: 1\nM1: " + m + "M2: " + m + rt),
               "c.yml:4:1: unknown key 'rectifed' in a calibration; did you mean 'rectified'? (valid keys: image_width, "
-              "image_height, configuration, rectified, M1, D1, M2, D2, R, T, R1, R2, P1, P2, Q, baseline_mm, focal_length_px, rms_px)");
+              "image_height, configuration, rectified, M1, D1, M2, D2, R, T, R1, R2, P1, P2, Q, baseline_mm, focal_length_px, rms_px, source)");
     EXPECT_EQ(readError(head + "M1: " + m + "M2: " + m + rt + "T: [1, 2, 3]\n"),
               "c.yml:16:1: key 'T' given twice in one map: first at 15:1, again at 16:1; remove one of them (expected an OpenCV "
               "FileStorage YAML calibration)");

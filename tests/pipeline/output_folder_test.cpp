@@ -87,17 +87,61 @@ TEST(OutputFolder, AFolderHoldingAnotherKindIsRefusedUnlessForced) {
     EXPECT_NE(why.find("--force"), std::string::npos) << why;
     EXPECT_EQ(readTextFile(rec + "/summary.json"), "{\"status\": \"complete\"}\n");
     EXPECT_FALSE(fs::exists(rec + "/" + OutputFolder::kLockFile));
-    // The same kind, an unknown folder and a lock-only claim are let in.
-    EXPECT_NO_THROW(OutputFolder(rec, OutputClaim{OutputKind::Recording, false, ""}));
+    // A lock-only claim is let in; the same kind is not, unless its command made the
+    // folder (its marker): files that look like a recording may be anyone's.
     EXPECT_NO_THROW(OutputFolder(rec, OutputClaim{OutputKind::None, false, ""}));
-    // Forced: what it held is gone, the folder is the run's.
+    EXPECT_NE(errorOf([&] { OutputFolder(rec, OutputClaim{OutputKind::Recording, false, ""}); }), "");
+    // Forced: what it held is gone, the folder is the run's (marked so).
     { OutputFolder forced(rec, OutputClaim{OutputKind::Run, true, "binocle run"}); }
-    EXPECT_TRUE(fs::is_empty(rec));
+    EXPECT_EQ(entriesOf(rec), std::vector<std::string>{});
+    EXPECT_EQ(readTextFile(rec + "/" + OutputFolder::kMarkerFile), "run binocle run\n");
+    EXPECT_EQ(outputKindOf(rec), OutputKind::Run);
+    writeText(rec + "/frames.jsonl", "{}\n");
+    EXPECT_NO_THROW(OutputFolder(rec, OutputClaim{OutputKind::Run, false, "binocle run"}));
     const std::string exp = dir.str("exp");
     fs::create_directories(exp);
     writeText(exp + "/results.json", "{}");
     const std::string why2 = errorOf([&] { OutputFolder(exp, OutputClaim{OutputKind::Run, false, "binocle run"}); });
     EXPECT_NE(why2.find("an experiment's results"), std::string::npos) << why2;
+}
+
+// Issue 35: a folder belongs to the command that made it. The user's own files (a
+// results.csv), an MCAP recording and another command's folder are refused, naming the
+// folder, what it holds and the flag; a folder a refused claim made goes again, marker too.
+TEST(OutputFolder, AFolderBelongsToTheCommandThatMadeIt) {
+    TempDir dir;
+    const std::string mine = dir.str("mine");
+    fs::create_directories(mine);
+    writeText(mine + "/results.csv", "my,own\n1,2\n");
+    std::string why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Experiment, false, "binocle experiment"}); });
+    EXPECT_NE(why.find("output folder " + mine + " holds an experiment's results (results.csv)"), std::string::npos) << why;
+    EXPECT_NE(why.find("pass --force"), std::string::npos) << why;
+    EXPECT_EQ(readTextFile(mine + "/results.csv"), "my,own\n1,2\n");
+    writeText(mine + "/notes.txt", "x");
+    fs::remove(mine + "/results.csv");
+    why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Design, false, "binocle design"}); });
+    EXPECT_NE(why.find("holds files Binocle did not write there (notes.txt)"), std::string::npos) << why;
+    // Python's functions are told force=True.
+    why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Run, false, "binocle.Rig.run"}); });
+    EXPECT_NE(why.find("pass force=True"), std::string::npos) << why;
+
+    const std::string bag = dir.str("bag");
+    fs::create_directories(bag);
+    writeText(bag + "/bag_0.mcap", "x");
+    writeText(bag + "/summary.json", "{}");
+    EXPECT_EQ(outputKindOf(bag), OutputKind::Recording);
+    why = errorOf([&] { OutputFolder(bag, OutputClaim{OutputKind::Run, false, "binocle run"}); });
+    EXPECT_NE(why.find("holds a recording (an MCAP file: bag_0.mcap)"), std::string::npos) << why;
+
+    const std::string made = dir.str("made");
+    { OutputFolder run(made, OutputClaim{OutputKind::Run, false, "binocle run"}); writeText(made + "/frames.jsonl", "{}\n"); }
+    why = errorOf([&] { OutputFolder(made, OutputClaim{OutputKind::Experiment, false, "binocle experiment"}); });
+    EXPECT_NE(why.find("holds the output of a run (frames.jsonl), made by binocle run"), std::string::npos) << why;
+
+    // A claim that wrote nothing takes back the folders it made, parents too.
+    const std::string fresh = dir.str("fresh");
+    { OutputFolder nothing(fresh + "/deeper/", OutputClaim{OutputKind::View, false, "binocle view"}); }
+    EXPECT_FALSE(fs::exists(fresh));
 }
 
 TEST(OutputFolder, APlantedSymlinkAsLockFileIsNotFollowed) {

@@ -200,7 +200,9 @@ TEST(Record, RefusesAFolderThatHoldsAnythingAndLosesNothing) {
     binocle::test::writeText(dir.str("busy/notes.txt"), "keep me");
     auto r = binocle::test::runCli("record " + dir.str("rig.yaml") + " --out " + dir.str("busy"));
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find(dir.str("busy") + " is not empty (it holds notes.txt): refusing to record over it"), std::string::npos)
+    EXPECT_NE(r.output.find("output folder " + dir.str("busy") + " holds files Binocle did not write there (notes.txt): "
+                            "binocle record writes a recording only into a new or empty folder; choose another folder"),
+              std::string::npos)
         << r.output;
     EXPECT_EQ(readFile(dir.str("busy/notes.txt")), "keep me");
     EXPECT_FALSE(fs::exists(dir.str("busy/frames.csv")));

@@ -143,7 +143,12 @@ public:
     // Writes the last chunk, Data End, the summary, the footer and the magic; closes the file.
     void close();
 
+    // Every message written, including those of the open chunk (not on disk yet).
     const Statistics &statistics() const;
+    // The messages a reader of the file recovers: those of the chunks written whole (and
+    // fsync'ed with sync_chunks), in the order they were written. A write that fails is
+    // cut back off the file, so this stays exact after a full disk; close() adds the last chunk.
+    uint64_t durableMessageCount() const;
     uint64_t bytesWritten() const;
     const std::string &path() const;
 

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <unistd.h>
@@ -97,7 +98,23 @@ inline std::vector<std::string> splitFields(std::string_view line) {
 
 [[noreturn]] inline void refuse(const std::string &what) { throw sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT, what); }
 
+
 } // namespace detail
+
+// A file of the recording in `folder` as it resolves (symbolic links followed), when that
+// lies outside the folder: a `left/` planted as a link to elsewhere would have replay read
+// whatever it points at. Empty when the file stays inside (or cannot be resolved: the
+// reader's own check then says it does not exist).
+inline std::string outsideOf(const std::filesystem::path &folder, const std::filesystem::path &file) {
+    std::error_code ec;
+    const std::filesystem::path base = std::filesystem::canonical(folder, ec);
+    if (ec) return {};
+    const std::filesystem::path real = std::filesystem::weakly_canonical(file, ec);
+    if (ec) return {};
+    const auto rel = real.lexically_relative(base);
+    if (!rel.empty() && *rel.begin() != "..") return {};
+    return real.string();
+}
 
 // Reads the text of frames.csv; `origin` names it in messages. The header may order
 // the columns as it likes (each exactly once); blank lines and a UTF-8 byte order mark are skipped. Image paths must

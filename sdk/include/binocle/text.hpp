@@ -65,6 +65,21 @@ inline std::string printable(std::string_view text, size_t maxChars = 80) {
     return out;
 }
 
+// What a file that is not a regular file is, for a refusal: "a FIFO", "a character
+// device" (/dev/zero), "a folder", ... from its st_mode.
+inline std::string fileTypeName(unsigned mode) {
+    switch (mode & 0170000u) { // S_IFMT
+    case 0010000u: return "a FIFO";
+    case 0020000u: return "a character device";
+    case 0040000u: return "a folder";
+    case 0060000u: return "a block device";
+    case 0100000u: return "a regular file";
+    case 0120000u: return "a symbolic link";
+    case 0140000u: return "a socket";
+    default: return "not a file";
+    }
+}
+
 // A relative path that stays inside the folder it is relative to: not empty, not
 // absolute, no ".." component, no NUL. "left/000001.png" yes; "../x", "/etc/passwd",
 // "a/../../b" no. `why` says what is wrong.
