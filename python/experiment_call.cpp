@@ -15,7 +15,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
+#include <functional>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace fs = std::filesystem;
@@ -24,38 +26,50 @@ namespace binocle::python {
 
 namespace {
 
-// An experiment in progress: asked to start no further test (Ctrl-C, the interpreter's
-// exit), and waited for.
+// An experiment in progress, its tests on a thread of their own: asked to start no
+// further test (Ctrl-C, the interpreter's exit), waited for and joined by the call or,
+// when the interpreter exits first, by the exit hook.
 class ExperimentWork final : public Ending {
 public:
     std::atomic<bool> stop{false};
-    // False once the interpreter exits: no test may start then.
-    bool begin() {
+    std::optional<OutputFolder> folder; // claimed before the tests start
+    // Starts the tests; false (nothing started) once the interpreter exits.
+    bool start(std::function<void()> tests) {
         std::lock_guard<std::mutex> lock(mutex_);
-        started_ = !exiting_;
-        return started_;
-    }
-    void finished() {
-        std::lock_guard<std::mutex> lock(mutex_);
-        done_ = true;
-        ended_.notify_all();
+        if (exiting_) return false;
+        worker_ = std::thread([this, tests = std::move(tests)] {
+            tests();
+            std::lock_guard<std::mutex> done(mutex_);
+            done_ = true;
+            ended_.notify_all();
+        });
+        return true;
     }
     bool waitFor(std::chrono::milliseconds wait) {
         std::unique_lock<std::mutex> lock(mutex_);
         return ended_.wait_for(lock, wait, [&] { return done_; });
     }
+    // Waits for the tests' thread, then lets go of the output folder (its lock).
+    void join() {
+        std::lock_guard<std::mutex> lock(joining_);
+        if (worker_.joinable()) worker_.join();
+        folder.reset();
+    }
     // The test in progress ends, no other starts; the tables say "interrupted".
     void endAtExit() override {
         stop = true;
-        std::unique_lock<std::mutex> lock(mutex_);
-        exiting_ = true;
-        ended_.wait(lock, [&] { return !started_ || done_; });
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            exiting_ = true;
+        }
+        join();
     }
 
 private:
-    std::mutex mutex_;
+    std::mutex mutex_, joining_;
     std::condition_variable ended_;
-    bool started_ = false, done_ = false, exiting_ = false;
+    std::thread worker_;
+    bool done_ = false, exiting_ = false;
 };
 
 } // namespace
@@ -74,27 +88,26 @@ py::dict experiment(const py::object &file, const py::object &set, const py::obj
     options.stop = &work->stop;
     auto host = std::make_unique<PluginHost>();
     std::optional<Experiment> e;
-    std::optional<OutputFolder> folder;
     withoutGil([&] {
         // Everything is checked before the first test runs (as `binocle experiment`).
         e.emplace(loadExperiment(path, *host, overrides));
         options.out_dir = outText ? *outText : "out/" + e->name;
-        folder.emplace(options.out_dir, OutputClaim{OutputKind::Experiment, options.replace, "binocle.experiment"});
+        work->folder.emplace(options.out_dir, OutputClaim{OutputKind::Experiment, options.replace, "binocle.experiment"});
     });
     // The tests run on a thread of their own, so that this one sees Ctrl-C: no further
     // test starts, the tables say "interrupted", then the KeyboardInterrupt goes on. Nothing
-    // below throws before the join (a waiting thread abandoned at exit waits for ever).
-    if (!work->begin()) throw Error("Python is exiting: the experiment was not started");
+    // below throws before the join (a thread abandoned at exit waits for ever meanwhile;
+    // the exit hook joins the tests' thread then).
     ExperimentResult result;
     std::exception_ptr error;
-    std::thread worker([&] {
+    const bool started = work->start([&] {
         try {
             result = runExperiment(*e, *host, options);
         } catch (...) {
             error = std::current_exception();
         }
-        work->finished();
     });
+    if (!started) throw Error("Python is exiting: the experiment was not started");
     std::optional<py::error_already_set> interrupt;
     while (!withoutGil([&] { return work->waitFor(kSignalPoll); })) {
         if (!interrupt && PyErr_CheckSignals() != 0) {
@@ -103,8 +116,7 @@ py::dict experiment(const py::object &file, const py::object &set, const py::obj
         }
     }
     withoutGil([&] {
-        worker.join();
-        folder.reset();
+        work->join();
         host.reset();
     });
     if (interrupt) throw *interrupt;

@@ -180,3 +180,4 @@ def test_experiment_in_a_daemon_thread_when_the_interpreter_exits(tmp_path):
     assert status == 0 and "main thread ends" in output, output
     written = read_json(str(tmp_path / "out" / "results.json"))
     assert written["status"] == "interrupted" and len(written["tests"]) < 8, written
+    assert not (tmp_path / "out" / ".binocle-lock").exists()
