@@ -3,7 +3,8 @@
 #                    [OUTPUT_DIRECTORY <dir>] [NO_INSTALL])
 #
 # Builds a Binocle plugin: a MODULE library with hidden visibility that exports only
-# its init symbol (binocle_plugin_init, enforced by a linker version script), named
+# its init symbols (binocle_plugin_init, and binocle_plugin_init_error when the plugin
+# defines it; enforced by a linker version script), named
 # binocle_<name>.so. <name> must be the name the plugin declares in its table
 # ([a-z0-9_]+): the host finds a rig's plugin by that file name alone, and refuses a
 # file whose name differs. Installed with the SDK, so that a plugin built outside this
@@ -34,14 +35,16 @@ function(binocle_add_plugin name)
     CXX_VISIBILITY_PRESET hidden
     C_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON)
-  # Export the init symbol only: a version script also hides the weak template
-  # instantiations (std::string, ...) that visibility flags alone leave exported.
+  # Export the init symbols only (binocle_plugin_init, and the optional
+  # binocle_plugin_init_error of binocle/abi/init_error.h: a pattern, so that a plugin
+  # without it links with any linker): a version script also hides the weak template
+  # instantiations (std::string, ...) that visibility flags alone leave exported. Written
+  # when its text changes only.
   set(version_script "${CMAKE_BINARY_DIR}/binocle_plugin.map")
-  if(NOT EXISTS "${version_script}")
-    file(WRITE "${version_script}" "{ global: binocle_plugin_init; local: *; };\n")
-  endif()
+  file(CONFIGURE OUTPUT "${version_script}" CONTENT "{ global: binocle_plugin_init*; local: *; };\n")
   if(NOT APPLE AND NOT WIN32)
     target_link_options(${target} PRIVATE "LINKER:--version-script=${version_script}")
+    set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS "${version_script}")
   endif()
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY "${ARG_OUTPUT_DIRECTORY}")

@@ -1,130 +1,53 @@
 // SPDX-License-Identifier: MIT
 // The `binocle` Python module (_binocle; binocle/__init__.py re-exports it): Rig and its
 // runs, experiment(), plugins(), the exceptions. The same framework code as the CLI.
+#include "python/arguments.hpp"
 #include "python/convert.hpp"
-#include "python/run_stream.hpp"
+#include "python/experiment_call.hpp"
+#include "python/lifecycle.hpp"
+#include "python/run.hpp"
 
 #include "config/rig_config.hpp"
-#include "core/atomic_file.hpp"
 #include "core/log.hpp"
-#include "core/output_folder.hpp"
-#include "experiment/experiment.hpp"
 #include "host/install_prefix.hpp"
 #include "host/setting_json.hpp"
 #include "input/image_file.hpp"
 
 #include <pybind11/stl.h>
 
-#include <condition_variable>
 #include <cstdlib>
-#include <mutex>
-#include <optional>
-#include <thread>
-#include <filesystem>
+#include <limits>
 
 namespace py = pybind11;
 using namespace binocle;
 using namespace binocle::python;
-namespace fs = std::filesystem;
 
 namespace {
 
-// How often a waiting iterator looks for Ctrl-C (PyErr_CheckSignals).
-constexpr std::chrono::milliseconds kSignalPoll{50};
-
 PyObject *g_error = nullptr, *g_usageError = nullptr, *g_pluginError = nullptr;
-
-// A mistake in the call's arguments: raised as binocle.UsageError (a ValueError).
-struct ArgumentError : Error {
-    using Error::Error;
-};
 
 std::shared_ptr<const LoadedRig> loadRigFile(const std::string &file, const py::object &set) {
     auto loaded = std::make_shared<LoadedRig>();
     loaded->host = std::make_unique<PluginHost>();
     std::vector<Override> overrides;
     for (const std::string &text : setTexts(set)) overrides.push_back(Override::parse(text));
-    py::gil_scoped_release release;
     // No scan: the rig opens only the plugins it names (as `binocle run`).
-    loaded->rig = loadRig(file, overrides, *loaded->host);
+    withoutGil([&] { loaded->rig = loadRig(file, overrides, *loaded->host); });
     return loaded;
 }
 
-// The iterator of Rig.run(): frames as they finish; the run on its own thread.
-class Run {
-public:
-    Run(std::shared_ptr<const LoadedRig> rig, const StreamOptions &options) {
-        py::gil_scoped_release release;
-        stream_ = std::make_unique<RunStream>(std::move(rig), options);
-    }
-    ~Run() { close(false); }
-
-    Frame next() {
-        if (!stream_) throw py::stop_iteration();
-        for (;;) {
-            std::shared_ptr<OwnedFrame> frame;
-            RunStream::Next n;
-            {
-                py::gil_scoped_release release;
-                n = stream_->next(frame, kSignalPoll);
-            }
-            if (n == RunStream::Next::Frame) return toFrame(std::move(frame));
-            if (n == RunStream::Next::End) {
-                close(true);
-                throw py::stop_iteration();
-            }
-            if (PyErr_CheckSignals() != 0) {
-                // Ctrl-C: the run stops as `binocle run` does on SIGINT (frames in flight
-                // finished, summary written, status interrupted), then the
-                // KeyboardInterrupt goes on.
-                py::error_already_set pending;
-                close(false);
-                throw pending;
-            }
-        }
-    }
-
-    // Stops the run (if still going) and waits for it; its error is raised when `raise`.
-    void close(bool raise) {
-        if (!stream_) return;
-        {
-            py::gil_scoped_release release;
-            if (!raise) stream_->stop();
-            try {
-                stream_->finish();
-            } catch (...) {
-                summary_ = stream_->summary();
-                stream_.reset();
-                if (raise) throw;
-                return;
-            }
-            summary_ = stream_->summary();
-            stream_.reset();
-        }
-    }
-
-    py::object summary() const { return summary_.is_null() ? py::none() : toPython(summary_); }
-
-private:
-    std::unique_ptr<RunStream> stream_;
-    nlohmann::ordered_json summary_;
-};
-
 class Rig {
 public:
-    Rig(const std::string &file, const py::object &set) : rig_(loadRigFile(file, set)) {}
+    Rig(const py::object &file, const py::object &set) : rig_(loadRigFile(*pathText(file, "file"), set)) {}
 
-    std::unique_ptr<Run> run(const py::object &frames, const py::object &out, bool force, bool progress, int64_t queue_depth) {
+    std::unique_ptr<Run> run(const py::object &frames, const py::object &out, const py::object &force, const py::object &progress,
+                             const py::object &queue_depth) {
         StreamOptions options;
-        if (!frames.is_none()) {
-            options.max_frames = frames.cast<int64_t>();
-            if (options.max_frames < 1) throw ArgumentError("frames=" + std::to_string(options.max_frames) + ": expected a whole number >= 1 (or None: until the source ends)");
-        }
-        if (!out.is_none()) options.out_dir = py::str(out).cast<std::string>();
-        if (queue_depth < 1) throw ArgumentError("queue_depth=" + std::to_string(queue_depth) + ": expected a whole number >= 1");
-        options.depth = static_cast<size_t>(queue_depth);
-        options.force = force;
-        options.progress = progress;
+        options.max_frames = wholeNumber(frames, "frames", 1, std::numeric_limits<int64_t>::max(), "until the source ends").value_or(-1);
+        options.out_dir = pathText(out, "out", "nothing written").value_or("");
+        options.force = flag(force, "force");
+        options.progress = flag(progress, "progress");
+        options.depth = static_cast<size_t>(*wholeNumber(queue_depth, "queue_depth", 1));
         return std::make_unique<Run>(rig_, options);
     }
 
@@ -135,74 +58,15 @@ private:
 };
 
 // What `binocle plugins` finds: the same search path and the same isolated scan.
-std::unique_ptr<PluginHost> scannedHost(const std::vector<std::string> &load, int64_t timeout_ms) {
-    if (timeout_ms < 100) throw ArgumentError("timeout_ms=" + std::to_string(timeout_ms) + ": expected a whole number >= 100");
+std::unique_ptr<PluginHost> scannedHost(const py::object &load, const py::object &timeout_ms) {
+    const std::vector<std::string> files = textList(load, "load");
+    const auto timeout = static_cast<int32_t>(*wholeNumber(timeout_ms, "timeout_ms", 100, std::numeric_limits<int32_t>::max()));
     auto host = std::make_unique<PluginHost>();
-    py::gil_scoped_release release;
-    for (const auto &p : load) host->load(p);
-    host->scan(ScanMode::Isolated, static_cast<int32_t>(timeout_ms));
+    withoutGil([&] {
+        for (const auto &p : files) host->load(p);
+        host->scan(ScanMode::Isolated, timeout);
+    });
     return host;
-}
-
-py::dict experiment(const std::string &file, const py::object &set, const py::object &out, const std::vector<std::string> &tests,
-                    bool force, bool progress) {
-    const std::vector<std::string> overrides = setTexts(set);
-    const std::string outText = out.is_none() ? "" : py::str(out).cast<std::string>();
-    ExperimentResult result;
-    ExperimentOptions options;
-    {
-        py::gil_scoped_release release;
-        PluginHost host;
-        // Everything is checked before the first test runs (as `binocle experiment`).
-        const Experiment e = loadExperiment(file, host, overrides);
-        options.out_dir = outText.empty() ? "out/" + e.name : outText;
-        options.progress = progress;
-        options.replace = force;
-        options.only = tests;
-        const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, force, "binocle.experiment"});
-        // The tests run on a thread of their own, so that this one sees Ctrl-C: no further
-        // test starts, the tables say "interrupted", then the KeyboardInterrupt goes on.
-        std::atomic<bool> stop{false};
-        options.stop = &stop;
-        std::exception_ptr error;
-        std::mutex mutex;
-        std::condition_variable ended;
-        bool done = false;
-        std::thread worker([&] {
-            try {
-                result = runExperiment(e, host, options);
-            } catch (...) {
-                error = std::current_exception();
-            }
-            std::lock_guard<std::mutex> lock(mutex);
-            done = true;
-            ended.notify_all();
-        });
-        std::optional<py::error_already_set> interrupt;
-        for (std::unique_lock<std::mutex> lock(mutex); !ended.wait_for(lock, kSignalPoll, [&] { return done; });) {
-            if (interrupt || stop) continue;
-            lock.unlock();
-            py::gil_scoped_acquire acquire;
-            if (PyErr_CheckSignals() != 0) {
-                interrupt.emplace();
-                stop = true;
-            }
-            lock.lock();
-        }
-        worker.join();
-        if (interrupt) {
-            py::gil_scoped_acquire acquire;
-            throw *interrupt;
-        }
-        if (error) std::rethrow_exception(error);
-    }
-    // What the command wrote, as data: results.json (rows under "tests", with their
-    // per-repeat details), plus where it lies and the run's own counts.
-    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(readTextFile((fs::path(options.out_dir) / "results.json").string()));
-    doc["out"] = options.out_dir;
-    doc["failed"] = result.failed;
-    doc["seconds"] = result.seconds;
-    return toPython(doc).cast<py::dict>();
 }
 
 void translate(std::exception_ptr p) {
@@ -237,6 +101,8 @@ PYBIND11_MODULE(_binocle, m) {
     LogOptions log;
     log.program = "binocle";
     setupLogging(log);
+    // numpy's C API, the exit hook, the fork handler (docs/python.md, "Threads, fork and exit").
+    setUpLifecycle();
 
     g_error = newException(m, "Error", "An error of Binocle: a file, key, value, plugin or device, named with what was expected "
                                        "(the message of the `binocle` command for the same mistake).",
@@ -277,12 +143,14 @@ PYBIND11_MODULE(_binocle, m) {
                     "The frames of a run, in order, as they finish; the pipeline works on its own threads meanwhile.\n"
                     "Leaving the loop early (break, an exception, Ctrl-C) or close() stops the run as SIGINT does for\n"
                     "`binocle run`: the frames in flight are finished, the summary (summary.json with out=) says\n"
-                    "'interrupted'.")
+                    "'interrupted'. Usable from any thread (each frame goes to one caller; close() from another\n"
+                    "thread ends the iteration); ended the same way when the interpreter exits; a child forked\n"
+                    "after it started cannot use it (binocle.Error).")
         .def("__iter__", [](py::object self) { return self; })
         .def("__next__", &Run::next)
-        .def("close", [](Run &r) { r.close(false); }, "Stops the run, if still going, and waits for its end.")
+        .def("close", &Run::close, "Stops the run, if still going, and waits for its end.")
         .def("__enter__", [](py::object self) { return self; })
-        .def("__exit__", [](Run &r, const py::object &, const py::object &, const py::object &) { r.close(false); })
+        .def("__exit__", [](Run &r, const py::object &, const py::object &, const py::object &) { r.close(); })
         .def_property_readonly("summary", &Run::summary,
                                "The run's summary (as summary.json: status, frame_count, metrics ...) once it ended; None before.");
 
@@ -291,7 +159,7 @@ PYBIND11_MODULE(_binocle, m) {
                     "set: {'matcher.num_disparities': 128} or ['matcher.num_disparities=128']; values other than\n"
                     "strings are written as YAML (True -> true). A bad key or value raises binocle.UsageError with the\n"
                     "CLI's message (file:line:col, 'did you mean').")
-        .def(py::init<const std::string &, const py::object &>(), py::arg("file"), py::arg("set") = py::none())
+        .def(py::init<const py::object &, const py::object &>(), py::arg("file"), py::arg("set") = py::none())
         .def("run", &Rig::run, py::arg("frames") = py::none(), py::arg("out") = py::none(), py::arg("force") = false,
              py::arg("progress") = false, py::arg("queue_depth") = 4,
              "Runs the rig's stage pipeline (that of `binocle run`) and returns the iterator of its frames.\n"
@@ -305,31 +173,31 @@ PYBIND11_MODULE(_binocle, m) {
         .def_property_readonly("matcher", [](const Rig &r) { return r.config().matcher().plugin; }, "the matcher plugin's name")
         .def("__repr__", [](const Rig &r) { return "<binocle.Rig '" + r.config().name + "' " + r.config().file + ">"; });
 
-    m.def("experiment", &experiment, py::arg("file"), py::arg("set") = py::none(), py::arg("out") = py::none(),
-          py::arg("tests") = std::vector<std::string>{}, py::arg("force") = false, py::arg("progress") = false,
+    m.def("experiment", &binocle::python::experiment, py::arg("file"), py::arg("set") = py::none(), py::arg("out") = py::none(),
+          py::arg("tests") = py::tuple(), py::arg("force") = false, py::arg("progress") = false,
           "Runs an experiment file as `binocle experiment FILE --set KEY=VALUE --out DIR --tests ...` does and\n"
           "returns what it wrote into DIR (default out/<name>) as results.json, a dict with the rows under 'tests'\n"
           "([{'test': id, 'status': ..., column: value ...}]), plus 'out' (DIR), 'failed' and 'seconds'.");
     m.def(
         "plugins",
-        [](const std::vector<std::string> &load, int64_t timeout_ms) {
+        [](const py::object &load, const py::object &timeout_ms) {
             const auto host = scannedHost(load, timeout_ms);
             py::list out;
             for (const auto &p : host->plugins()) out.append(toPython(pluginJson(p)));
             return out;
         },
-        py::arg("load") = std::vector<std::string>{}, py::arg("timeout_ms") = 5000,
+        py::arg("load") = py::tuple(), py::arg("timeout_ms") = 5000,
         "The plugins `binocle plugins` lists: [{'name', 'kind', 'version', 'abi_version', 'api_version',\n"
         "'description', 'path', 'settings': [{'name', 'type', 'default', 'unit', 'help', 'min', 'max', ...}]}].");
     m.def(
         "refused_plugins",
-        [](const std::vector<std::string> &load, int64_t timeout_ms) {
+        [](const py::object &load, const py::object &timeout_ms) {
             const auto host = scannedHost(load, timeout_ms);
             py::list out;
             for (const auto &r : host->refused()) out.append(py::dict(py::arg("path") = r.path, py::arg("reason") = r.reason));
             return out;
         },
-        py::arg("load") = std::vector<std::string>{}, py::arg("timeout_ms") = 5000,
+        py::arg("load") = py::tuple(), py::arg("timeout_ms") = 5000,
         "The files `binocle plugins` lists as refused: [{'path', 'reason'}].");
     m.def("plugin_search_path", &PluginHost::defaultSearchPath,
           "The folders searched for plugins: $BINOCLE_PLUGIN_PATH, then <prefix>/lib/binocle/plugins.");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// JSON, frames and --set texts between the framework and Python.
+// JSON and frames between the framework and Python.
 #include "python/convert.hpp"
 
 namespace binocle::python {
@@ -67,23 +67,6 @@ Frame toFrame(std::shared_ptr<OwnedFrame> f) {
     out.seconds = f->seconds;
     out.latency_s = f->latency_s;
     return out;
-}
-
-std::vector<std::string> setTexts(const py::object &set) {
-    std::vector<std::string> texts;
-    if (set.is_none()) return texts;
-    if (py::isinstance<py::dict>(set)) {
-        const py::module_ json = py::module_::import("json");
-        for (const auto &[key, value] : set.cast<py::dict>()) {
-            const std::string text = py::isinstance<py::str>(value) ? value.cast<std::string>()
-                                                                    : json.attr("dumps")(value).cast<std::string>();
-            texts.push_back(py::str(key).cast<std::string>() + "=" + text);
-        }
-        return texts;
-    }
-    if (py::isinstance<py::str>(set)) return {set.cast<std::string>()};
-    for (const auto &item : set) texts.push_back(py::str(item).cast<std::string>());
-    return texts;
 }
 
 } // namespace binocle::python

@@ -28,8 +28,4 @@ struct Frame {
 
 Frame toFrame(std::shared_ptr<OwnedFrame> frame);
 
-// A dict {"key": value} or a list of "key=value" texts as --set texts: strings as they
-// are, other values as YAML (JSON) text: True -> true, [1, 2] -> [1, 2].
-std::vector<std::string> setTexts(const py::object &set);
-
 } // namespace binocle::python

@@ -91,14 +91,16 @@ void RunStream::onFrame(const FrameResult &r) {
 
 RunStream::Next RunStream::next(std::shared_ptr<OwnedFrame> &frame, std::chrono::milliseconds wait) {
     std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait_for(lock, wait, [&] { return !queue_.empty() || done_; });
+    // A stopped run has no frame to give (stop() dropped the queue): its consumer learns
+    // the end at once, without waiting for the frames in flight (finish() does).
+    changed_.wait_for(lock, wait, [&] { return !queue_.empty() || done_ || stop_; });
     if (!queue_.empty()) {
         frame = std::move(queue_.front());
         queue_.pop_front();
         changed_.notify_all();
         return Next::Frame;
     }
-    return done_ ? Next::End : Next::Waiting;
+    return done_ || stop_ ? Next::End : Next::Waiting;
 }
 
 void RunStream::stop() {
@@ -109,10 +111,15 @@ void RunStream::stop() {
 }
 
 void RunStream::finish() {
-    if (joined_) return;
-    if (thread_.joinable()) thread_.join();
-    joined_ = true;
-    folder_.reset(); // the lock of the output folder goes once the summary is written
+    {
+        // Two threads may finish one run (one closes it while another iterates): one joins.
+        std::lock_guard<std::mutex> lock(joining_);
+        if (!joined_) {
+            if (thread_.joinable()) thread_.join();
+            joined_ = true;
+            folder_.reset(); // the lock of the output folder goes once the summary is written
+        }
+    }
     std::exception_ptr error;
     {
         std::lock_guard<std::mutex> lock(mutex_);

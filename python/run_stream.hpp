@@ -60,11 +60,12 @@ public:
     RunStream &operator=(const RunStream &) = delete;
 
     enum class Next { Frame, Waiting, End };
-    // Waits up to `wait` for a frame. End: the run is over and every frame was taken; the
-    // run's error, if it failed, is rethrown by finish().
+    // Waits up to `wait` for a frame. End: the run is over and every frame was taken, or
+    // it was stopped; the run's error, if it failed, is rethrown by finish(). Safe from
+    // several threads (each frame goes to one), as stop() and finish() are.
     Next next(std::shared_ptr<OwnedFrame> &frame, std::chrono::milliseconds wait);
     void stop();
-    // Waits for the run's thread; rethrows its error (binocle::Error) once.
+    // Waits for the run's thread; rethrows its error (binocle::Error) once, to one caller.
     void finish();
     // The run's summary (as summary.json), once finish() returned; null before.
     nlohmann::ordered_json summary() const;
@@ -82,6 +83,7 @@ private:
     std::condition_variable changed_;
     std::deque<std::shared_ptr<OwnedFrame>> queue_;
     bool done_ = false;
+    std::mutex joining_; // finish(): one thread joins, the others wait for it
     bool joined_ = false;
     std::exception_ptr error_;
     nlohmann::ordered_json summary_;

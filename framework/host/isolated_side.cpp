@@ -53,7 +53,9 @@ protected:
 // What the plugin writes to stdout (info) and stderr (warning) reaches the host's log as
 // lines tagged with the plugin, not as raw bytes on Binocle's terminal. A thread forwards
 // what comes while the helper waits; drain() forwards what a call wrote before its reply
-// goes out, so that the host sees a call's lines during that call.
+// goes out, so that the host sees a call's lines during that call, a last line without
+// its newline included (after the last call the host closes the socket: nothing written
+// later could reach it).
 class OutputForwarder {
 public:
     OutputForwarder() {
@@ -92,13 +94,13 @@ public:
         if (!thread_.joinable()) return;
         std::fflush(nullptr);
         std::lock_guard<std::mutex> lock(mutex_);
-        for (int i = 0; i < 2; ++i) readAvailable(i);
+        for (int i = 0; i < 2; ++i) readAvailable(i, true);
     }
 
 private:
-    // Reads what the pipe holds; sends whole lines (and the rest at end of file). Returns
-    // false at end of file. Holds mutex_.
-    bool readAvailable(int i) {
+    // Reads what the pipe holds; sends whole lines (and the rest at end of file, or when
+    // `rest`). Returns false at end of file. Holds mutex_.
+    bool readAvailable(int i, bool rest) {
         bool open = true;
         for (;;) {
             char buf[4096];
@@ -111,7 +113,7 @@ private:
             open = n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK);
             break;
         }
-        for (size_t nl; (nl = pending_[i].find('\n')) != std::string::npos || (!open && !pending_[i].empty());) {
+        for (size_t nl; (nl = pending_[i].find('\n')) != std::string::npos || ((!open || rest) && !pending_[i].empty());) {
             const std::string line = pending_[i].substr(0, nl);
             pending_[i].erase(0, nl == std::string::npos ? std::string::npos : nl + 1);
             sendLog(kFromOutput, i == 0 ? BINOCLE_LOG_INFO : BINOCLE_LOG_WARNING, line);
@@ -127,7 +129,7 @@ private:
             }
             std::lock_guard<std::mutex> lock(mutex_);
             for (int i = 0; i < 2; ++i)
-                if (fds[i].fd >= 0 && (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) && !readAvailable(i))
+                if (fds[i].fd >= 0 && (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) && !readAvailable(i, false))
                     fds[i].fd = -1; // end of file: stop polling it
         }
     }

@@ -9,6 +9,9 @@
 #include "host/plugin_kinds.hpp"
 #include "host/plugin_name.hpp"
 
+#include <binocle/abi/init_error.h>
+#include <binocle/text.hpp>
+
 #include <algorithm>
 #include <boost/dll/shared_library.hpp>
 #include <cerrno>
@@ -252,9 +255,16 @@ const PluginRecord &PluginHost::inspect(const std::string &path) const {
     } catch (...) {
         throw Error("init symbol threw an exception (exceptions must not cross the ABI)");
     }
-    if (!h)
+    if (!h) {
+        std::string why;
+        if (lib->has(BINOCLE_PLUGIN_INIT_ERROR_SYMBOL)) {
+            const char *said = lib->get<const char *()>(BINOCLE_PLUGIN_INIT_ERROR_SYMBOL)();
+            // The plugin's words, as text that cannot play tricks on a terminal.
+            if (said && *said) why = ": " + sdk::printable(said, 500);
+        }
         throw Error("init returned no table for host ABI " + std::to_string(BINOCLE_ABI_VERSION) + ", API " +
-                    std::to_string(BINOCLE_API_VERSION));
+                    std::to_string(BINOCLE_API_VERSION) + why);
+    }
     // The header layout is frozen: these fields are safe to read whatever the ABI.
     if (h->abi_version != BINOCLE_ABI_VERSION)
         throw Error("built for ABI version " + std::to_string(h->abi_version) + ", but this host speaks ABI version " +

@@ -4,6 +4,7 @@
 // binocle_add_python_plugin(); it learns <name> from its own file (dladdr), so the host
 // sees an ordinary plugin of that name. Design and rules: sdk/README.md ("Plugins in
 // Python"); the class's side of the rules: python_shim.py.
+#include <binocle/abi/init_error.h>
 #include <binocle/plugin.hpp>
 #include <binocle/settings.hpp>
 
@@ -51,17 +52,46 @@ private:
     PyObject *o_ = nullptr;
 };
 
+// True once the interpreter is being torn down and this thread does not hold the GIL:
+// PyGILState_Ensure would then end the thread inside C++ code (pthread_exit through
+// destructors) or never return. The `binocle` module ends its runs before that (its exit
+// hook); this is the bridge's own guard.
+bool pythonGone() {
+    if (!Py_IsInitialized()) return true;
+#if PY_VERSION_HEX >= 0x030D0000
+    return Py_IsFinalizing() && !PyGILState_Check();
+#else
+    return _Py_IsFinalizing() && !PyGILState_Check();
+#endif
+}
+
 // The GIL for the length of a call; the interpreter is started, or joined, once.
 class Gil {
 public:
-    Gil() : state_(PyGILState_Ensure()) {}
+    Gil() : state_(take()) {}
     ~Gil() { PyGILState_Release(state_); }
     Gil(const Gil &) = delete;
     Gil &operator=(const Gil &) = delete;
 
 private:
+    static PyGILState_STATE take() {
+        if (pythonGone()) throw Error(BINOCLE_ERR_INTERNAL, "python bridge: the Python interpreter is exiting; no call into Python now");
+        return PyGILState_Ensure();
+    }
     PyGILState_STATE state_;
 };
+
+// Drops references with the GIL, or leaves them (the objects go with the process) once
+// the interpreter is being torn down.
+template <class... Refs>
+void dropAll(Refs &...refs) {
+    if (pythonGone()) {
+        (refs.release(), ...);
+        return;
+    }
+    Gil gil;
+    ((refs = Ref()), ...);
+}
 
 // What the module declared, read once when the library is first asked for its table.
 struct Module {
@@ -296,12 +326,7 @@ public:
 
     PyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &) : m_(module()), instance_(makeInstance(m_, p)) {}
 
-    ~PyMatcher() override {
-        Gil gil;
-        instance_ = Ref();
-        leftBytes_ = Ref();
-        rightBytes_ = Ref();
-    }
+    ~PyMatcher() override { dropAll(instance_, leftBytes_, rightBytes_); }
 
     void compute(const binocle_image &left, const binocle_image &right, binocle_image &disparity) override {
         checkInputs(left, right, disparity);
@@ -417,10 +442,7 @@ public:
     PyEvaluator(const binocle::sdk::Params &p, binocle::sdk::Host &host)
         : m_(module()), host_(host), instance_(makeInstance(m_, p)) {}
 
-    ~PyEvaluator() override {
-        Gil gil;
-        instance_ = Ref();
-    }
+    ~PyEvaluator() override { dropAll(instance_); }
 
     void evaluate(const binocle_eval_input &in) override {
         Gil gil;
@@ -491,19 +513,27 @@ private:
 
 } // namespace
 
-// The init symbol: the table of the kind the module declares, or NULL (and why, on
-// stderr: the host's refusal says only that there was no table) when it cannot load.
+// The init symbol: the table of the kind the module declares, or NULL when it cannot
+// load (why: binocle_plugin_init_error, which the host adds to its refusal).
 extern "C" BINOCLE_PLUGIN_EXPORT const binocle_plugin_header *binocle_plugin_init(uint32_t, uint32_t) {
     try {
         Module &m = module();
-        if (!m.failure.empty()) {
-            std::fprintf(stderr, "binocle python plugin: %s\n", m.failure.c_str());
-            return nullptr;
-        }
+        if (!m.failure.empty()) return nullptr;
         namespace d = binocle::sdk::detail;
         if (m.kind == "evaluator")
             return &d::evaluatorTable<PyEvaluator>(m.name.c_str(), m.version.c_str(), m.description.c_str())->header;
         return &d::matcherTable<PyMatcher>(m.name.c_str(), m.version.c_str(), m.description.c_str())->header;
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+// Why init returned NULL: the module's file, the line and the Python error
+// ("cannot read .../binocle_x.py: SyntaxError: invalid syntax (at .../binocle_x.py:7:5)").
+extern "C" BINOCLE_PLUGIN_EXPORT const char *binocle_plugin_init_error() {
+    try {
+        const Module &m = module();
+        return m.failure.empty() ? nullptr : m.failure.c_str();
     } catch (...) {
         return nullptr;
     }

@@ -211,10 +211,17 @@ def dtype_of(result):
     return f"numpy array of dtype {dtype}, shape {tuple(shape) if shape is not None else '?'}"
 
 
+SHIM = "<binocle python bridge>"  # this file's name in tracebacks (python_bridge.cpp compiles it so)
+
+
 def explain(error):
-    """'ValueError: message (at file.py:12 in compute)': the innermost frame."""
+    """'ValueError: message (at file.py:12 in compute)': the innermost frame outside this
+    shim; a syntax error at its own file, line and column."""
+    if isinstance(error, SyntaxError) and error.filename:
+        where = f"{error.filename}:{error.lineno}" + (f":{error.offset}" if error.offset else "")
+        return f"{type(error).__name__}: {error.msg} (at {where})"
     text = f"{type(error).__name__}: {error}"
-    frames = traceback.extract_tb(error.__traceback__)
+    frames = [f for f in traceback.extract_tb(error.__traceback__) if f.filename != SHIM]
     if frames:
         last = frames[-1]
         text += f" (at {last.filename}:{last.lineno} in {last.name})"

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
 # Type stubs of the binocle module (python/binocle_module.cpp), for editors and mypy.
+import os
 from types import TracebackType
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
@@ -12,6 +13,8 @@ API_VERSION: int
 
 # A dict of rig keys to values, or "key=value" texts, as `binocle run --set`.
 SetArg = Union[None, Mapping[str, Any], Sequence[str], str]
+# A path: a str or a pathlib.Path (bytes are refused).
+PathArg = Union[str, "os.PathLike[str]"]
 
 class Error(RuntimeError):
     """An error of Binocle, with the message of the `binocle` command for the same mistake."""
@@ -70,8 +73,8 @@ class Run(Iterator[Frame]):
 
 class Rig:
     """A rig file, loaded and checked as `binocle run RIG --set KEY=VALUE` does."""
-    def __init__(self, file: str, set: SetArg = None) -> None: ...
-    def run(self, frames: Optional[int] = None, out: Optional[str] = None, force: bool = False,
+    def __init__(self, file: PathArg, set: SetArg = None) -> None: ...
+    def run(self, frames: Optional[int] = None, out: Optional[PathArg] = None, force: bool = False,
             progress: bool = False, queue_depth: int = 4) -> Run: ...
     @property
     def name(self) -> str: ...
@@ -84,7 +87,7 @@ class Rig:
     @property
     def matcher(self) -> str: ...
 
-def experiment(file: str, set: SetArg = None, out: Optional[str] = None, tests: Sequence[str] = (),
+def experiment(file: PathArg, set: SetArg = None, out: Optional[PathArg] = None, tests: Sequence[str] = (),
                force: bool = False, progress: bool = False) -> Dict[str, Any]:
     """Runs an experiment file as `binocle experiment`; returns its results.json (rows under 'tests')
     plus 'out', 'failed' and 'seconds'."""

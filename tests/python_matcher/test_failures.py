@@ -5,6 +5,7 @@
 import json
 import os
 import re
+import shutil
 import subprocess
 import time
 
@@ -106,14 +107,14 @@ def children(pid):
 def peak_rss(tmp_path, behaviour):
     """(Binocle's peak RSS, its helper processes' peak RSS) in MB over a 6-frame run."""
     out = str(tmp_path / behaviour)
-    p = subprocess.Popen([CLI, "run", SIM_RIG, "--out", out, "--set", "source.frames=6", "--set",
-                          misbehaving(behaviour, True)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    host = helpers = 0.0
-    while p.poll() is None:
-        host = max(host, rss_mb(p.pid))
-        helpers = max([helpers] + [rss_mb(c) for c in children(p.pid)])
-        time.sleep(0.02)
-    assert p.returncode == 0 and summary(out)["status"] == "ok", p.stderr.read()
+    with subprocess.Popen([CLI, "run", SIM_RIG, "--out", out, "--set", "source.frames=6", "--set",
+                           misbehaving(behaviour, True)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True) as p:
+        host = helpers = 0.0
+        while p.poll() is None:
+            host = max(host, rss_mb(p.pid))
+            helpers = max([helpers] + [rss_mb(c) for c in children(p.pid)])
+            time.sleep(0.02)
+        assert p.returncode == 0 and summary(out)["status"] == "ok", p.stderr.read()
     return host, helpers
 
 
@@ -160,9 +161,10 @@ def test_plugins_reads_tables_without_running_modules():
     # A module that raises on import is listed: its table is read without running it.
     assert re.search(r"py_import_error\s+matcher\s+0\.1\.0", r.stdout), r.stdout
     assert "ImportError" not in listing
-    # A table that is not literals is refused, the line said on stderr.
-    assert "binocle_py_dynamic_table.so: init returned no table" in r.stdout, r.stdout
-    assert re.search(r"binocle_py_dynamic_table\.py:10: version must be a literal", r.stderr), r.stderr
+    # A table that is not literals is refused, the file and line said in the refusal.
+    assert re.search(r"binocle_py_dynamic_table\.so: init returned no table for host ABI 1, API 1: cannot read \S+"
+                     r"binocle_py_dynamic_table\.py: PluginDefinitionError: \S+binocle_py_dynamic_table\.py:10: version "
+                     r"must be a literal", r.stdout), r.stdout
 
 
 def test_class_changed_at_import_fails_create(tmp_path):
@@ -179,3 +181,65 @@ def test_module_that_cannot_be_imported_fails_create(tmp_path):
     assert "create failed" in r.stderr and "cannot load" in r.stderr
     assert re.search(r"ImportError: fixture: a module this plugin needs is missing \(at \S+binocle_py_import_error\.py:7 "
                      r"in <module>\)", r.stderr), r.stderr
+
+
+def python_plugin(folder, name, source):
+    """binocle_<name>.so (a copy of the bridge, as binocle_add_python_plugin makes it) and,
+    unless source is None, binocle_<name>.py in `folder`; returns the environment that
+    finds them."""
+    folder.mkdir(exist_ok=True)
+    search = os.environ["BINOCLE_PLUGIN_PATH"]
+    bridge = next(os.path.join(d, "binocle_numpy_sad.so") for d in search.split(":")
+                  if os.path.exists(os.path.join(d, "binocle_numpy_sad.so")))
+    shutil.copy(bridge, folder / f"binocle_{name}.so")
+    if source is not None:
+        (folder / f"binocle_{name}.py").write_text(source)
+    return {**os.environ, "BINOCLE_PLUGIN_PATH": f"{folder}:{search}"}
+
+
+SYNTAX_ERROR = """import numpy as np
+class Broken:
+    version = "0.1.0"
+    def compute(self, left, right) return left
+binocle_plugin = Broken
+"""
+
+
+@pytest.mark.parametrize("isolated", [False, True])
+def test_module_that_does_not_parse_or_is_missing_says_why(tmp_path, isolated):
+    folder = tmp_path / "plugins"
+    python_plugin(folder, "py_syntax", SYNTAX_ERROR)
+    env = python_plugin(folder, "py_nofile", None)
+    syntax = (f"{folder}/binocle_py_syntax.so: init returned no table for host ABI 1, API 1: cannot read "
+              f"{folder}/binocle_py_syntax.py: SyntaxError: ")
+    missing = (f"{folder}/binocle_py_nofile.so: init returned no table for host ABI 1, API 1: cannot read "
+               f"{folder}/binocle_py_nofile.py: FileNotFoundError: [Errno 2] No such file or directory")
+    listing = subprocess.run([CLI, "plugins"], capture_output=True, text=True, env=env, timeout=600)
+    assert syntax in listing.stdout and missing in listing.stdout, listing.stdout
+    assert re.search(re.escape(syntax) + r"(invalid syntax|expected ':') \(at " + re.escape(f"{folder}/binocle_py_syntax.py") +
+                     r":4:\d+\)", listing.stdout), listing.stdout
+    for name, said in (("py_syntax", syntax), ("py_nofile", missing)):
+        block = f"plugin: {name}" + (", isolation: process" if isolated else "")
+        r = subprocess.run([CLI, "run", SIM_RIG, "--frames", "1", "--out", str(tmp_path / name), "--set",
+                            "matcher={" + block + "}"], capture_output=True, text=True, env=env, timeout=600)
+        assert r.returncode != 0 and said.split(": init returned")[1] in r.stderr, r.stderr
+
+
+def test_last_line_without_a_newline_reaches_the_log(tmp_path):
+    env = python_plugin(tmp_path / "plugins", "py_print", """import numpy as np
+class Prints:
+    version = "0.1.0"
+    description = "prints a line, then words without a newline"
+    def __init__(self, settings):
+        pass
+    def compute(self, left, right):
+        print("a whole line")
+        print("last words", end="")
+        return np.zeros(left.shape[:2], np.float32)
+binocle_plugin = Prints
+""")
+    r = subprocess.run([CLI, "run", SIM_RIG, "--frames", "1", "--out", str(tmp_path / "out"), "--set",
+                        "matcher={plugin: py_print, isolation: process}"], capture_output=True, text=True, env=env,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "[py_print] a whole line" in r.stderr and "[py_print] last words" in r.stderr, r.stderr

@@ -8,5 +8,6 @@
 #include "abi/matcher.h"
 #include "abi/cloud_transform.h"
 #include "abi/evaluator.h"
+#include "abi/init_error.h"
 
 #endif /* BINOCLE_ABI_H */

@@ -38,7 +38,8 @@ def _paeth(a, b, c):
 
 def read_png_gray16(path):
     """A 16-bit greyscale PNG (no interlace) as an H x W uint16 array."""
-    data = open(path, "rb").read()
+    with open(path, "rb") as f:
+        data = f.read()
     assert data[:8] == b"\x89PNG\r\n\x1a\n", path
     pos, idat, width, height = 8, b"", 0, 0
     while pos < len(data):

@@ -2,6 +2,7 @@
 # Errors as Python exceptions with the CLI's own message; a run left early (break,
 # close, Ctrl-C) stops cleanly and writes its summary.
 import os
+import pathlib
 import signal
 import threading
 import time
@@ -48,7 +49,7 @@ def test_bad_set_has_the_cli_message(key, value, words):
 
 def test_bad_rig_file_has_file_line_column(tmp_path):
     bad = tmp_path / "bad.yaml"
-    bad.write_text(open(ALOE).read().replace("  num_disparities: 256", "  num_disparites: 256"))
+    bad.write_text(pathlib.Path(ALOE).read_text().replace("  num_disparities: 256", "  num_disparites: 256"))
     status, _, err = cli("run", str(bad), "--quiet", check=False)
     assert status == 1
     with pytest.raises(binocle.Error) as e:
