@@ -292,9 +292,6 @@ struct Reader::Impl {
         }
     }
 
-    // Reads the data section record by record from `offset`; a record cut short ends the
-    // scan (what came before is kept). Chunks are decompressed and checked here, so that
-    // the schemas and channels inside them are known and a damaged last chunk is left out.
     // The data section in the file, read as the walk goes: its records end at DataEnd or
     // the Footer, and where a record is cut short, claims more bytes than the file or the
     // cap allows, or has opcode 0 (`stop` says which).
