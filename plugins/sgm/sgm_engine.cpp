@@ -17,6 +17,11 @@ namespace {
 // disparity on its right exceeds the one on its left by more than this (sgm_fill.hpp).
 constexpr float kOcclusionJumpPx = 1.0f;
 
+// The column offsets of the paths whose predecessors lie in the previous row: the
+// vertical one (4 paths), or with the two diagonals (5 and 8 paths).
+constexpr int kVertical[] = {0};
+constexpr int kVerticalAndDiagonals[] = {-1, 0, 1};
+
 std::string mebibytes(double bytes) { return std::to_string(static_cast<long long>(std::ceil(bytes / 1048576.0))); }
 
 } // namespace
@@ -30,9 +35,6 @@ Engine::Engine(const Settings &settings, const Kernels &kernels) : settings_(set
     // disparity instead of 3, and nothing written back by the pass up); the pass up runs
     // the horizontal paths and sums all four in a row that stays in cache.
     keepDownPath_ = settings_.paths == 4;
-    if (settings_.paths == 4) downDx_ = upDx_ = {0};
-    else if (settings_.paths == 5) downDx_ = {-1, 0, 1};
-    else downDx_ = upDx_ = {-1, 0, 1};
     // P2 by intensity step g: smaller across an edge, where disparity jumps are likely
     // (Hirschmueller 2008), never below P1.
     for (int g = 0; g < 256; ++g) {
@@ -160,87 +162,131 @@ void Engine::finishRow(Stripe &s, const uint16_t *sum, int y) {
                           s.rightKey.data(), fixed_.ptr<uint16_t>(y));
 }
 
-// Rows y0 .. y1 - 1. The vertical and diagonal paths start kStripeOverlapRows above (and
-// for the pass up, below) the stripe, so that they arrive warmed up; the sums of those
-// rows go to scratch.
-void Engine::matchStripe(Stripe &s) {
-    const int y0 = s.y0, y1 = s.y1;
-    const size_t w = static_cast<size_t>(width_), ds = pathStride(paddedDisp_);
-    const PathParams pp{settings_.p1, p2ByStep_ + 255};
-    uint8_t *rowsL = s.pathRows.data();
-    uint8_t *mins = s.pathMins.data();
-    // Direction i has two rows (previous, current), swapped after each image row.
-    auto pathL = [&](size_t dir, int parity) { return rowsL + (2 * dir + parity) * w * ds; };
-    auto pathMin = [&](size_t dir, int parity) { return mins + (2 * dir + parity) * w; };
-
-    const uint8_t *prevRowL[kMaxRowPaths] = {};
-    auto run = [&](const std::vector<int> &dxs, int yFirst, int yLast, int step, bool down) {
-        int parity = 0, pairedRow = -1;
-        for (int y = yFirst;; y += step) {
-            const bool own = y >= y0 && y < y1;
-            const uint8_t *cost = costRow(s, y, own, down);
-            // Rows outside the stripe only carry their paths on: no sums.
-            uint16_t *sum = nullptr;
-            // 4 paths, pass up: this row's horizontal paths, kept whole (8-bit) for the fused
-            // kernel, which adds them. Those of two rows at once (four serial chains side by
-            // side, whose latencies overlap): this one's, and the next one's for the next step.
-            const uint8_t *forward = nullptr, *backward = nullptr;
-            if (own && keepDownPath_) {
-                if (!down) {
-                    const size_t row = w * paddedDisp_;
-                    uint8_t *const paths[4] = {s.horizontalPaths.data(), s.horizontalPaths.data() + row,
-                                               s.horizontalPaths.data() + 2 * row, s.horizontalPaths.data() + 3 * row};
-                    const int next = y + step;
-                    const bool second = y == pairedRow;
-                    if (!second) {
-                        const bool pair = y != yLast && next >= y0 && next < y1;
-                        const uint8_t *costs[2] = {cost, pair ? costRow(s, next, true, false) : nullptr};
-                        const uint8_t *greys[2] = {greyLeft_.ptr<uint8_t>(y), greyLeft_.ptr<uint8_t>(pair ? next : y)};
-                        uint8_t *const forwards[2] = {paths[0], paths[2]}, *const backwards[2] = {paths[1], paths[3]};
-                        kernels_.horizontalPaths(costs, pair ? 2 : 1, width_, paddedDisp_, greys, pp, s.horizontal.data(),
-                                                 forwards, backwards);
-                        pairedRow = pair ? next : -1;
-                    }
-                    forward = paths[second ? 2 : 0];
-                    backward = paths[second ? 3 : 1];
-                }
-            } else if (own) {
-                // The pass down stores the horizontal paths' sums; the rest add to them (the
-                // pass up to the pass down's).
-                sum = twoPass_ ? volumeRow(y) : s.scratchSum.data();
-                if (down)
-                    kernels_.horizontalRow(cost, width_, paddedDisp_, greyLeft_.ptr<uint8_t>(y), pp,
-                                           s.horizontal.data(), sum, true);
-            }
-            const bool first = y == yFirst;
-            const bool keep = keepDownPath_ && own && down;
-            const uint8_t *greyPrev = first ? nullptr : greyLeft_.ptr<uint8_t>(y - step);
-            RowPaths rp{};
-            rp.count = static_cast<int>(dxs.size());
-            for (size_t i = 0; i < dxs.size(); ++i) {
-                rp.dx[i] = dxs[i];
-                rp.prevL[i] = first ? nullptr : prevRowL[i];
-                rp.prevMin[i] = pathMin(i, parity ^ 1);
-                rp.curL[i] = keep ? downPathRow(y) : pathL(i, parity);
-                rp.curMin[i] = pathMin(i, parity);
-                prevRowL[i] = rp.curL[i];
-            }
-            if (own && keepDownPath_ && !down) {
-                // The vertical path, the sums and the winner in one kernel; then the check.
-                kernels_.upWtaRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp,
-                                  downPathRow(y), forward, backward, wtaParams(), s.best.data(), s.bestSum.data(),
-                                  fixed_.ptr<uint16_t>(y));
-                finishRow(s, nullptr, y);
-            } else {
-                kernels_.pathRow(cost, width_, paddedDisp_, rp, greyLeft_.ptr<uint8_t>(y), greyPrev, pp, sum, false);
-                if (own && (down != twoPass_)) finishRow(s, sum, y);
-            }
-            parity ^= 1;
-            if (y == yLast) break;
+// The path costs of a pass from row to row: each direction has two rows of the stripe's
+// scratch (previous, current), swapped after each image row; its first row has no
+// predecessors.
+class Engine::PathRows {
+public:
+    // dxs: the column offset of each path's predecessor in the previous row.
+    template <size_t N>
+    PathRows(const Engine &e, Stripe &s, const int (&dxs)[N])
+        : rows_(s.pathRows.data()), mins_(s.pathMins.data()), width_(static_cast<size_t>(e.width_)),
+          stride_(pathStride(e.paddedDisp_)), dxs_(dxs), count_(N) {
+        static_assert(N <= kMaxRowPaths, "at most kMaxRowPaths paths a row");
+    }
+    // The paths of the next row; their costs go to `kept` (a row of the volume the pass up
+    // reads) where given, else to the scratch rows.
+    RowPaths next(uint8_t *kept = nullptr) {
+        RowPaths rp{};
+        rp.count = static_cast<int>(count_);
+        for (size_t i = 0; i < count_; ++i) {
+            rp.dx[i] = dxs_[i];
+            rp.prevL[i] = prev_[i];
+            rp.prevMin[i] = mins_ + (2 * i + (parity_ ^ 1)) * width_;
+            rp.curL[i] = kept ? kept : rows_ + (2 * i + parity_) * width_ * stride_;
+            rp.curMin[i] = mins_ + (2 * i + parity_) * width_;
+            prev_[i] = rp.curL[i];
         }
-    };
-    run(downDx_, s.first, y1 - 1, 1, true);
-    if (twoPass_) run(upDx_, s.last - 1, y0, -1, false);
+        parity_ ^= 1;
+        return rp;
+    }
+
+private:
+    uint8_t *rows_, *mins_;
+    size_t width_, stride_;
+    const int *dxs_;
+    size_t count_, parity_ = 0;
+    const uint8_t *prev_[kMaxRowPaths] = {};
+};
+
+Engine::Row Engine::rowOf(Stripe &s, int y, int yFirst, bool down) {
+    const bool own = y >= s.y0 && y < s.y1;
+    const int step = down ? 1 : -1;
+    return {y, own, costRow(s, y, own, down), greyLeft_.ptr<uint8_t>(y),
+            y == yFirst ? nullptr : greyLeft_.ptr<uint8_t>(y - step)};
+}
+
+// Rows y0 .. y1 - 1. The vertical and diagonal paths start kStripeOverlapRows above (and
+// for the pass up, below) the stripe, so that they arrive warmed up; rows outside the
+// stripe only carry their paths on: no sums, no winner.
+void Engine::matchStripe(Stripe &s) {
+    const PathParams pp{settings_.p1, p2ByStep_ + 255};
+    if (settings_.paths == 4) matchFourPaths(s, pp);
+    else if (settings_.paths == 5) matchFivePaths(s, pp);
+    else matchEightPaths(s, pp);
+}
+
+// 5 paths, one pass down: the horizontal paths store a row of sums, the three from above
+// add to it, then the winner.
+void Engine::matchFivePaths(Stripe &s, const PathParams &pp) {
+    PathRows paths(*this, s, kVerticalAndDiagonals);
+    for (int y = s.first; y < s.y1; ++y) {
+        const Row r = rowOf(s, y, s.first, true);
+        uint16_t *sum = r.own ? s.scratchSum.data() : nullptr;
+        if (sum) kernels_.horizontalRow(r.cost, width_, paddedDisp_, r.grey, pp, s.horizontal.data(), sum, true);
+        kernels_.pathRow(r.cost, width_, paddedDisp_, paths.next(), r.grey, r.greyPrev, pp, sum, false);
+        if (sum) finishRow(s, sum, y);
+    }
+}
+
+// 8 paths: the pass down stores the horizontal paths' sums in the volume and adds the
+// three from above; the pass up adds the three from below, then the winner.
+void Engine::matchEightPaths(Stripe &s, const PathParams &pp) {
+    PathRows down(*this, s, kVerticalAndDiagonals);
+    for (int y = s.first; y < s.y1; ++y) {
+        const Row r = rowOf(s, y, s.first, true);
+        uint16_t *sum = r.own ? volumeRow(y) : nullptr;
+        if (sum) kernels_.horizontalRow(r.cost, width_, paddedDisp_, r.grey, pp, s.horizontal.data(), sum, true);
+        kernels_.pathRow(r.cost, width_, paddedDisp_, down.next(), r.grey, r.greyPrev, pp, sum, false);
+    }
+    PathRows up(*this, s, kVerticalAndDiagonals);
+    for (int y = s.last - 1; y >= s.y0; --y) {
+        const Row r = rowOf(s, y, s.last - 1, false);
+        uint16_t *sum = r.own ? volumeRow(y) : nullptr;
+        kernels_.pathRow(r.cost, width_, paddedDisp_, up.next(), r.grey, r.greyPrev, pp, sum, false);
+        if (sum) finishRow(s, sum, y);
+    }
+}
+
+// 4 paths: the pass down keeps its costs and its vertical path (8-bit) for the pass up,
+// which runs the path from below, the horizontal paths and the winner: for each own row
+// one fused kernel adds the four and finds the winner, nothing 16-bit written to a row.
+void Engine::matchFourPaths(Stripe &s, const PathParams &pp) {
+    PathRows down(*this, s, kVertical);
+    for (int y = s.first; y < s.y1; ++y) {
+        const Row r = rowOf(s, y, s.first, true);
+        kernels_.pathRow(r.cost, width_, paddedDisp_, down.next(r.own ? downPathRow(y) : nullptr), r.grey, r.greyPrev,
+                         pp, nullptr, false);
+    }
+    // The horizontal paths of own rows, kept whole (8-bit) for the fused kernel: those of
+    // two rows at once (four serial chains side by side, whose latencies overlap), this
+    // row's (0, 1) and the next one's (2, 3) for the next step.
+    const size_t row = static_cast<size_t>(width_) * paddedDisp_;
+    uint8_t *const h[4] = {s.horizontalPaths.data(), s.horizontalPaths.data() + row,
+                           s.horizontalPaths.data() + 2 * row, s.horizontalPaths.data() + 3 * row};
+    bool second = false; // this row's horizontal paths were run with the row before
+    PathRows up(*this, s, kVertical);
+    for (int y = s.last - 1; y >= s.y0; --y) {
+        const Row r = rowOf(s, y, s.last - 1, false);
+        const RowPaths paths = up.next();
+        if (!r.own) {
+            kernels_.pathRow(r.cost, width_, paddedDisp_, paths, r.grey, r.greyPrev, pp, nullptr, false);
+            continue;
+        }
+        const bool pair = !second && y - 1 >= s.y0;
+        if (!second) {
+            const uint8_t *costs[2] = {r.cost, pair ? costRow(s, y - 1, true, false) : nullptr};
+            const uint8_t *greys[2] = {r.grey, greyLeft_.ptr<uint8_t>(pair ? y - 1 : y)};
+            uint8_t *const forwards[2] = {h[0], h[2]}, *const backwards[2] = {h[1], h[3]};
+            kernels_.horizontalPaths(costs, pair ? 2 : 1, width_, paddedDisp_, greys, pp, s.horizontal.data(),
+                                     forwards, backwards);
+        }
+        kernels_.upWtaRow(r.cost, width_, paddedDisp_, paths, r.grey, r.greyPrev, pp, downPathRow(y),
+                          h[second ? 2 : 0], h[second ? 3 : 1], wtaParams(), s.best.data(), s.bestSum.data(),
+                          fixed_.ptr<uint16_t>(y));
+        finishRow(s, nullptr, y);
+        second = pair;
+    }
 }
 
 void Engine::medianRow(Stripe &s, int y, cv::Mat &disparity, float invalid) {

@@ -100,7 +100,20 @@ private:
     // disparity NULL: no median.
     void runStripe(Stripe &s, cv::Mat *disparity, float invalid);
     void censusOf(Stripe &s);
+    // One row of a pass: whether it is the stripe's own (it counts) or a warm-up row, its
+    // costs (costRow), its grey row and the previous one on the pass (none for the first).
+    struct Row {
+        int y;
+        bool own;
+        const uint8_t *cost, *grey, *greyPrev;
+    };
+    class PathRows;
+    Row rowOf(Stripe &s, int y, int yFirst, bool down);
+    // The paths and the winner of a stripe, one function per path strategy.
     void matchStripe(Stripe &s);
+    void matchFourPaths(Stripe &s, const PathParams &pp);
+    void matchFivePaths(Stripe &s, const PathParams &pp);
+    void matchEightPaths(Stripe &s, const PathParams &pp);
     // The median of row y (its window clamped to the image) and its conversion to pixels.
     void medianRow(Stripe &s, int y, cv::Mat &disparity, float invalid);
     // The whole pair; disparity NULL: no median (computeFixed).
@@ -125,7 +138,6 @@ private:
     int width_ = 0, height_ = 0, paddedDisp_ = 0;
     bool twoPass_ = true;
     bool keepDownPath_ = false; // 4 paths: the pass down keeps its vertical path, not sums
-    std::vector<int> downDx_, upDx_; // predecessor offsets of the vertical and diagonal paths
     uint8_t p2ByStep_[511]; // P2 by intensity step -255..255 (PathParams::p2ByStep)
     cv::Mat greyLeft_, greyRight_, fixed_;
     AlignedVector<uint16_t> volume_;  // 8 paths: the pass down's sums

@@ -2,6 +2,7 @@
 // mcap::Reader: opens a file by its summary and chunk indexes, or scans its data section
 // when it has none (a file cut short, one written without indexes) and recovers every
 // complete chunk. Every size is checked against the file and the caps before allocating.
+#include "mcap_record_walk.hpp"
 #include "mcap_records.hpp"
 
 #include <binocle/text.hpp>
@@ -17,9 +18,12 @@
 namespace binocle::mcap {
 
 using detail::Cursor;
+using detail::kRecordHead;
+using detail::MemoryRecords;
+using detail::RecordAt;
+using detail::walkRecords;
 
 namespace {
-constexpr uint64_t kRecordHead = 9; // opcode + length
 constexpr uint64_t kFooterRecord = kRecordHead + 20;
 
 std::string hexOpcode(uint8_t op) {
@@ -211,25 +215,20 @@ struct Reader::Impl {
                             static_cast<int64_t>(summaryStart));
         }
         bool haveStats = false;
-        size_t i = 0;
-        const size_t end = static_cast<size_t>(footerAt - summaryStart);
-        while (i < end) {
-            const uint64_t offset = summaryStart + i;
-            Cursor h(summary.data() + i, end - i, at(offset));
-            const uint8_t op = h.u8("opcode");
-            const uint64_t len = h.u64("record length");
-            const uint8_t *b = h.run(len, "summary record");
-            Cursor c(b, static_cast<size_t>(len), at(offset));
-            switch (static_cast<Opcode>(op)) {
-            case Opcode::Schema: addSchema(parse<Schema>(c), at(offset)); break;
-            case Opcode::Channel: addChannel(parse<Channel>(c), at(offset)); break;
+        const MemoryRecords records(summary.data(), static_cast<size_t>(footerAt - summaryStart), summaryStart,
+                                    "mcap: " + path + ": record at offset ", "record length", "summary record");
+        walkRecords(records, summaryStart, [&](const RecordAt &r) {
+            Cursor c = records.fields(r);
+            switch (static_cast<Opcode>(r.op)) {
+            case Opcode::Schema: addSchema(parse<Schema>(c), at(r.offset)); break;
+            case Opcode::Channel: addChannel(parse<Channel>(c), at(r.offset)); break;
             case Opcode::Statistics: parseStatistics(c); haveStats = true; break;
-            case Opcode::ChunkIndex: chunks.push_back(parseChunkIndex(c, offset)); break;
-            case Opcode::MetadataIndex: readMetadata(c, offset); break;
+            case Opcode::ChunkIndex: chunks.push_back(parseChunkIndex(c, r.offset)); break;
+            case Opcode::MetadataIndex: readMetadata(c, r.offset); break;
             default: break; // attachment indexes, summary offsets, unknown: not needed
             }
-            i += static_cast<size_t>(kRecordHead + len);
-        }
+            return true;
+        });
         if (chunks.empty()) {
             note = "the summary has no chunk indexes";
             chunks.clear();
@@ -293,6 +292,37 @@ struct Reader::Impl {
         }
     }
 
+    // The data section in the file, read as the walk goes: its records end at DataEnd or
+    // the Footer, and where a record is cut short, claims more bytes than the file or the
+    // cap allows, or has opcode 0 (`stop` says which).
+    struct FileRecords {
+        const Impl &file;
+        std::string stop;
+        std::vector<uint8_t> body;
+
+        bool head(uint64_t offset, RecordAt &r) {
+            const uint64_t left = file.size - offset;
+            if (left < kRecordHead) {
+                stop = left > 0 ? "the last " + std::to_string(left) + " bytes are not a record"
+                                : "the file ends after a complete record";
+                return false;
+            }
+            try {
+                std::tie(r.op, r.length) = file.head(offset, file.size);
+            } catch (const Error &e) {
+                stop = e.what();
+                return false;
+            }
+            r.offset = offset;
+            if (r.op == 0) stop = file.at(offset) + " has opcode 0x00 (no record starts so)";
+            return r.op != 0 && !r.is(Opcode::DataEnd) && !r.is(Opcode::Footer);
+        }
+        Cursor fields(const RecordAt &r) {
+            body = file.body(r.offset, r.length);
+            return Cursor(body.data(), body.size(), file.at(r.offset));
+        }
+    };
+
     // Reads the data section record by record from `offset`; a record cut short ends the
     // scan (what came before is kept). Chunks are decompressed and checked here, so that
     // the schemas and channels inside them are known and a damaged last chunk is left out.
@@ -300,48 +330,30 @@ struct Reader::Impl {
         const std::string why = note;
         stats = Statistics{};
         std::string stop;
-        while (stop.empty()) {
-            if (size - offset < kRecordHead) {
-                if (size - offset > 0) stop = "the last " + std::to_string(size - offset) + " bytes are not a record";
-                else stop = "the file ends after a complete record";
-                break;
-            }
-            uint8_t op = 0;
-            uint64_t len = 0;
-            try {
-                std::tie(op, len) = head(offset, size);
-            } catch (const Error &e) {
-                stop = e.what();
-                break;
-            }
-            if (op == 0) {
-                stop = at(offset) + " has opcode 0x00 (no record starts so)";
-                break;
-            }
-            if (op == static_cast<uint8_t>(Opcode::DataEnd) || op == static_cast<uint8_t>(Opcode::Footer)) break;
-            if (op == static_cast<uint8_t>(Opcode::Chunk)) {
+        FileRecords data{*this, {}, {}};
+        walkRecords(data, offset, [&](const RecordAt &r) {
+            if (r.is(Opcode::Chunk)) {
                 try {
-                    scanChunk(offset, len);
+                    scanChunk(r.offset, r.length);
                 } catch (const Error &e) {
                     stop = e.what();
-                    break;
+                    return false;
                 }
-            } else if (op == static_cast<uint8_t>(Opcode::Schema) || op == static_cast<uint8_t>(Opcode::Channel) ||
-                       op == static_cast<uint8_t>(Opcode::Message) || op == static_cast<uint8_t>(Opcode::Metadata)) {
-                const auto b = body(offset, len);
-                Cursor c(b.data(), b.size(), at(offset));
-                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parse<Schema>(c), at(offset));
-                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parse<Channel>(c), at(offset));
-                else if (op == static_cast<uint8_t>(Opcode::Metadata)) {
+            } else if (r.is(Opcode::Schema) || r.is(Opcode::Channel) || r.is(Opcode::Message) || r.is(Opcode::Metadata)) {
+                Cursor c = data.fields(r);
+                if (r.is(Opcode::Schema)) addSchema(parse<Schema>(c), at(r.offset));
+                else if (r.is(Opcode::Channel)) addChannel(parse<Channel>(c), at(r.offset));
+                else if (r.is(Opcode::Metadata)) {
                     std::string name = c.str("name");
                     metadata.emplace_back(std::move(name), c.map("metadata"));
                 } else {
-                    countMessage(c, at(offset));
-                    looseMessages.push_back(offset);
+                    countMessage(c, at(r.offset));
+                    looseMessages.push_back(r.offset);
                 }
             }
-            offset += kRecordHead + len;
-        }
+            return true;
+        });
+        if (stop.empty()) stop = data.stop;
         stats.chunk_count = static_cast<uint32_t>(chunks.size());
         stats.schema_count = static_cast<uint16_t>(schemas.size());
         stats.channel_count = static_cast<uint32_t>(channels.size());
@@ -386,11 +398,11 @@ struct Reader::Impl {
         const Statistics before = stats;
         try {
             const auto records = load(index);
-            walkChunk(*records, offset, [&](uint8_t op, Cursor &r, uint64_t recordOffset) {
-                const std::string where = at(offset) + " (Chunk), inner record at " + std::to_string(recordOffset);
-                if (op == static_cast<uint8_t>(Opcode::Schema)) addSchema(parse<Schema>(r), where);
-                else if (op == static_cast<uint8_t>(Opcode::Channel)) addChannel(parse<Channel>(r), where);
-                else if (op == static_cast<uint8_t>(Opcode::Message)) countMessage(r, where);
+            walkChunk(*records, offset, [&](const RecordAt &record, Cursor &r) {
+                const std::string where = at(offset) + " (Chunk), inner record at " + std::to_string(record.offset);
+                if (record.is(Opcode::Schema)) addSchema(parse<Schema>(r), where);
+                else if (record.is(Opcode::Channel)) addChannel(parse<Channel>(r), where);
+                else if (record.is(Opcode::Message)) countMessage(r, where);
             });
         } catch (...) {
             chunks.pop_back();
@@ -400,19 +412,16 @@ struct Reader::Impl {
         }
     }
 
-    // Calls visit(opcode, cursor over its fields, offset in the records) for each record.
+    // Calls visit(record, cursor over its fields) for each of a chunk's records (their
+    // offsets in the records).
     template <typename Visit> void walkChunk(const std::vector<uint8_t> &records, uint64_t chunkOffset, Visit &&visit) const {
-        size_t i = 0;
-        while (i < records.size()) {
-            Cursor h(records.data() + i, records.size() - i,
-                     at(chunkOffset) + " (Chunk): inner record at " + std::to_string(i));
-            const uint8_t op = h.u8("opcode");
-            const uint64_t len = h.u64("length");
-            Cursor r(h.run(len, "inner record"), static_cast<size_t>(len),
-                     at(chunkOffset) + " (Chunk): inner record at " + std::to_string(i));
-            visit(op, r, i);
-            i += static_cast<size_t>(kRecordHead + len);
-        }
+        const MemoryRecords span(records.data(), records.size(), 0, at(chunkOffset) + " (Chunk): inner record at ",
+                                 "length", "inner record");
+        walkRecords(span, 0, [&](const RecordAt &r) {
+            Cursor c = span.fields(r);
+            visit(r, c);
+            return true;
+        });
     }
 
     // The chunk's records, decompressed and CRC-checked.
@@ -562,8 +571,9 @@ void Reader::readMessages(const std::function<bool(const MessageView &)> &visit,
         const ChunkInfo &k = r.chunks[u.chunk];
         const auto records = r.load(u.chunk);
         std::vector<MessageView> found;
-        r.walkChunk(*records, k.offset, [&](uint8_t op, detail::Cursor &c, uint64_t at) {
-            if (op != static_cast<uint8_t>(Opcode::Message)) return;
+        r.walkChunk(*records, k.offset, [&](const RecordAt &record, detail::Cursor &c) {
+            if (!record.is(Opcode::Message)) return;
+            const uint64_t at = record.offset;
             MessageView m = Impl::parseMessage(c);
             const auto ch = static_cast<uint16_t>(m.record_offset);
             if (!wanted(ch) || m.log_time < start_ns || m.log_time > end_ns) return;
