@@ -289,6 +289,7 @@ void Pipeline::write(RunState &s, const std::function<void(const FrameResult &)>
             try {
                 const auto t0 = Clock::now();
                 r.latency_s = secondsSince((*job)->grabbed);
+                r.calibration = &calibration_;
                 for (FrameWriter *w : s.writers) w->write(r);
                 const double written = secondsSince(t0);
                 r.seconds += written;
