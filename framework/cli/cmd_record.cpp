@@ -6,6 +6,7 @@
 #include "core/output_folder.hpp"
 #include "pipeline/recorder.hpp"
 #include "pipeline/stop_signal.hpp"
+#include "rosbag/rosbag_recording.hpp"
 
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
@@ -42,9 +43,9 @@ int record(const RecordArgs &args) {
     options.writer.png_compression = args.png_compression;
     options.writer.threads = args.writer_threads;
     if (!args.when_behind.empty()) options.drop_when_behind = args.when_behind == "drop";
-    options.format = args.format;
-    options.rosbag = args.rosbag;
-    checkRosbagOptions(options.rosbag);
+    checkRosbagOptions(args.rosbag);
+    // Where the pairs go: the folder of PNG pairs, or a rosbag2 bag; the recorder names neither.
+    options.sink = args.format == "mcap" ? rosbagRecordingSink(args.rosbag) : folderRecordingSink();
     // One recorder per folder, marked as a recording; the writer itself refuses a folder
     // that holds anything (a recording is never written over, --force or not).
     OutputFolder folder(args.out, OutputClaim{OutputKind::Recording, false, "binocle record"});

@@ -9,12 +9,12 @@
 #include "rosbag/rosbag_run_output.hpp"
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 
 #include <spdlog/spdlog.h>
 
 #include <iostream>
-#include <optional>
 
 namespace binocle::cli {
 namespace {
@@ -41,14 +41,15 @@ int runRig(const RunArgs &args) {
     if (!args.out.empty()) folder.emplace(args.out, OutputClaim{OutputKind::Run, args.force, "binocle run"});
     StopSignalGuard signals; // Ctrl-C / SIGTERM: finish the frames in flight, write the summary
     options.stop = &StopSignalGuard::requested();
-    // --mcap: the frames also go into DIR/bag, a rosbag2 bag (docs/ros2.md).
-    std::optional<RosbagRunOutput> bag;
+    // --mcap: the frames also go into DIR/bag, a rosbag2 bag (docs/ros2.md): one more
+    // writer of the writer stage, after the folder's.
+    std::unique_ptr<FrameWriter> bag;
     if (args.mcap && options.out_dir.empty()) throw UsageError("--mcap: expected --out DIR (the bag goes into DIR/bag)");
-    if (args.mcap) bag.emplace((std::filesystem::path(options.out_dir) / "bag").string(), args.rosbag);
-    Json summary = pipeline.run(options, [&](const FrameResult &r) {
-        if (bag) bag->onFrame(r, pipeline.calibration());
-    });
-    if (bag) bag->close();
+    if (args.mcap) {
+        bag = std::make_unique<RosbagFrameWriter>((std::filesystem::path(options.out_dir) / "bag").string(), args.rosbag);
+        options.writers.push_back(bag.get());
+    }
+    Json summary = pipeline.run(options);
     const bool interrupted = summary.value("status", "") == "interrupted";
     spdlog::info("binocle run: {} frame(s) of rig '{}'{}{}", summary.value("frame_count", int64_t{0}), rig.name,
                  interrupted ? " (interrupted)" : "",

@@ -17,6 +17,7 @@
 #include "pipeline/frame_writer.hpp"
 #include "pipeline/plugin_instances.hpp"
 #include "pipeline/run_summary.hpp"
+#include "pipeline/source_grab.hpp"
 #include "pipeline/stage_queue.hpp"
 #include "pipeline/stage_times.hpp"
 
@@ -273,11 +274,7 @@ Json Pipeline::run(const RunOptions &options, const std::function<void(const Fra
     // acts on the queue at the source, which is the rig's queue_depth.
     const size_t stageDepth = static_cast<size_t>(std::max(2, rt.matcher_instances));
     RunState s(options, static_cast<size_t>(rt.queue_depth), stageDepth);
-    bool live = false;
-    try {
-        live = sourceIsLive(source().statistics());
-    } catch (const std::exception &) {
-    }
+    const bool live = sourceIsLive(source());
     s.policy = rt.policy ? *rt.policy : live ? RuntimeOptions::Policy::Latest : RuntimeOptions::Policy::Lossless;
     const size_t matcherThreads = instances_->of<Matcher>().size();
     const size_t jobs = matcherThreads + 3 * stageDepth + 3;

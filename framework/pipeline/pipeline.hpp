@@ -52,6 +52,7 @@ struct FrameResult {
     uint64_t index = 0;    // 0, 1, 2 ... frames processed in this run (after drops)
     uint64_t sequence = 0; // the source's sequence number
     const LentFrame *frame = nullptr; // as the source lent it (extras, metadata)
+    const StereoCalibration *calibration = nullptr; // the run's (focal length, baseline): set on the writer stage
     cv::Mat rectified_left, rectified_right;
     cv::Mat disparity; // CV_32F
     // The planes the matcher attached to it (e.g. "disparity_filled"): handed to evaluators.

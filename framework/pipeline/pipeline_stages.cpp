@@ -8,6 +8,7 @@
 #include "core/image_io.hpp"
 #include "core/json.hpp"
 #include "core/progress.hpp"
+#include "pipeline/source_grab.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -40,7 +41,8 @@ void putGroundPose(binocle_eval_input &in, const RigConfig &rig) {
 } // namespace
 
 // Stage 1: grabs pairs and queues them by the policy. A grab waits in short slices so
-// that a stop request is seen within a fraction of a second even from a silent camera.
+// that a stop request is seen within a fraction of a second even from a silent camera
+// (grabWithin, shared with the recorder).
 void Pipeline::acquire(RunState &s) {
     const RuntimeOptions &rt = rig_.runtime;
     const bool retry = rt.on_source_error == RuntimeOptions::OnSourceError::Retry;
@@ -73,18 +75,7 @@ void Pipeline::acquire(RunState &s) {
             std::unique_ptr<LentFrame> frame;
             const auto grabStart = Clock::now();
             try {
-                const auto t0 = grabStart;
-                const int32_t total = s.options.grab_timeout_ms;
-                for (;;) {
-                    const int32_t left = total < 0 ? 250 : std::max<int32_t>(1, total - static_cast<int32_t>(secondsSince(t0) * 1000));
-                    try {
-                        frame = source().grab(std::min<int32_t>(250, left));
-                        break;
-                    } catch (const PluginError &e) {
-                        if (e.code() != BINOCLE_ERR_TIMEOUT || s.stopRequested() || s.aborted) throw;
-                        if (total >= 0 && secondsSince(t0) * 1000 >= total) throw;
-                    }
-                }
+                frame = grabWithin(source(), s.options.grab_timeout_ms, [&] { return s.stopRequested() || s.aborted; });
             } catch (const PluginError &e) {
                 if (s.stopRequested() && e.code() == BINOCLE_ERR_TIMEOUT) break;
                 if (!retry || (e.code() != BINOCLE_ERR_DEVICE && e.code() != BINOCLE_ERR_TIMEOUT)) throw;
@@ -298,6 +289,7 @@ void Pipeline::write(RunState &s, const std::function<void(const FrameResult &)>
             try {
                 const auto t0 = Clock::now();
                 r.latency_s = secondsSince((*job)->grabbed);
+                r.calibration = &calibration_;
                 for (FrameWriter *w : s.writers) w->write(r);
                 const double written = secondsSince(t0);
                 r.seconds += written;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Recording a rig's source to a folder in the recording format (sdk/include/binocle/recording.hpp):
-// the layout, frames.csv and the durability rules are the SDK's; this adds the writer pool.
+// the layout, frames.csv and the durability rules are the SDK's; this adds the writer pool,
+// and the loop that records a rig's source into any RecordingSink.
 #include "pipeline/recorder.hpp"
 
 #include "core/atomic_file.hpp"
@@ -8,7 +9,7 @@
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
 #include "host/plugin_instance.hpp"
-#include "rosbag/rosbag_recording.hpp"
+#include "pipeline/source_grab.hpp"
 
 #include <binocle/recording.hpp>
 
@@ -494,38 +495,47 @@ nlohmann::ordered_json recordingSummary(const RecordResult &r) {
     return j;
 }
 
+RecordingSinkFactory folderRecordingSink() {
+    return [](const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
+              const RecordingWriterOptions &options) -> std::unique_ptr<RecordingSink> {
+        return std::make_unique<RecordingWriter>(dir, calibrationYaml, rigYaml, options);
+    };
+}
+
 namespace {
 
-// The recording loop, the same for each format's writer (RecordingWriter, RosbagRecordingWriter).
-template <typename Writer>
-RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, const RecordOptions &options,
+// The recording loop, the same for every sink: grabs as the pipeline's acquire stage does
+// (grabWithin), hands each pair to the sink, ends on max_frames, a stop or the stream's end.
+RecordResult recordInto(RecordingSink &sink, Source &source, const std::string &dir, const RecordOptions &options,
                         const std::function<void(int64_t frames)> &onFrame) {
     RecordResult result;
-    bool live = false;
-    try {
-        const YAML::Node st = YAML::Load(source.statistics());
-        live = st.IsMap() && st["live"] && st["live"].as<bool>(false);
-    } catch (const std::exception &) {
-    }
-    result.dropped_when_behind = options.drop_when_behind.value_or(live);
+    result.dropped_when_behind = options.drop_when_behind.value_or(sourceIsLive(source));
     const auto begin = std::chrono::steady_clock::now();
     Progress progress(options.progress, "frame", options.max_frames);
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); };
+    auto stopped = [&] { return options.stop && options.stop->load(); };
     try {
         source.start();
         while (options.max_frames < 0 || result.grabbed < options.max_frames) {
-            if (options.stop && options.stop->load()) {
+            if (stopped()) {
                 result.status = "interrupted";
                 break;
             }
-            std::unique_ptr<LentFrame> frame = source.grab(options.grab_timeout_ms);
+            std::unique_ptr<LentFrame> frame;
+            try {
+                frame = grabWithin(source, options.grab_timeout_ms, stopped);
+            } catch (const PluginError &e) {
+                if (!stopped() || e.code() != BINOCLE_ERR_TIMEOUT) throw;
+                result.status = "interrupted"; // asked to stop while the source was silent
+                break;
+            }
             if (!frame) break;
             ++result.grabbed;
-            if (!writer.submit(*frame, !result.dropped_when_behind)) ++result.dropped_by_writer;
+            if (!sink.submit(*frame, !result.dropped_when_behind)) ++result.dropped_by_writer;
             frame.reset(); // the copy is queued: the source has its buffers back
             if (onFrame) onFrame(result.grabbed);
-            progress.update(writer.frameCount(), "recorded, " + std::to_string(result.dropped_by_writer) +
-                                                     " dropped (writers behind)");
+            progress.update(sink.frameCount(), "recorded, " + std::to_string(result.dropped_by_writer) +
+                                                   " dropped (writers behind)");
         }
         source.stop();
     } catch (const std::exception &e) {
@@ -537,7 +547,7 @@ RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, 
         }
     }
     try {
-        writer.finish();
+        sink.finish();
     } catch (const std::exception &e) {
         if (result.error.empty()) result.error = e.what();
         result.status = "error";
@@ -547,9 +557,9 @@ RecordResult recordWith(Writer &writer, Source &source, const std::string &dir, 
         result.source_statistics = source.statistics();
     } catch (const std::exception &) {
     }
-    result.frames = writer.frameCount();
+    result.frames = sink.frameCount();
     result.seconds = elapsed();
-    result.writer = writer.stats();
+    result.writer = sink.stats();
     try {
         writeFileAtomic((fs::path(dir) / "summary.json").string(), recordingSummary(result).dump(2) + "\n");
     } catch (const std::exception &e) {
@@ -566,14 +576,9 @@ RecordResult recordRig(const RigConfig &rig, const std::string &dir, const Recor
     std::string calibration;
     if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
     else calibration = source.calibration();
-    if (options.format == "mcap") {
-        RosbagRecordingWriter writer(dir, calibration, rig.resolved_yaml, options.rosbag, options.writer);
-        return recordWith(writer, source, dir, options, onFrame);
-    }
-    if (options.format != "folder")
-        throw Error("record: format '" + options.format + "': expected folder or mcap");
-    RecordingWriter writer(dir, calibration, rig.resolved_yaml, options.writer);
-    return recordWith(writer, source, dir, options, onFrame);
+    const RecordingSinkFactory &make = options.sink ? options.sink : folderRecordingSink();
+    std::unique_ptr<RecordingSink> sink = make(dir, calibration, rig.resolved_yaml, options.writer);
+    return recordInto(*sink, source, dir, options, onFrame);
 }
 
 } // namespace binocle

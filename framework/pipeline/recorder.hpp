@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: MIT
-// Recording a rig's source to a folder in the `recording` layout of plugins/replay/README.md:
-// lossless PNG images, frames.csv, calibration.yml and rig.yaml. Images are encoded and
-// written off the grab thread; a recording cut short is readable up to its last row.
+// Recording a rig's source into a RecordingSink (pipeline/recording_sink.hpp): by default
+// a folder in the `recording` layout of plugins/replay/README.md (lossless PNG images,
+// frames.csv, calibration.yml and rig.yaml). Images are encoded and written off the grab
+// thread; a recording cut short is readable up to its last row.
 #pragma once
 
 #include "config/rig_config.hpp"
 #include "host/plugin_host.hpp"
-#include "rosbag/rosbag_writer.hpp"
+#include "pipeline/recording_sink.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -23,33 +24,13 @@ namespace binocle {
 // holds (GRAY8, GRAY16, BGR8, RGB8 are recorded; RGB8 stays in RGB order here).
 cv::Mat recordableView(const binocle_image &im);
 
-// How a RecordingWriter spreads its work.
-struct RecordingWriterOptions {
-    int threads = 0;            // threads that encode and write images; 0 = two per core, 4..16
-    int png_compression = 1;    // zlib level 0..9; 1: lossless all the same, several times faster than 6
-    int queue_frames = 0;       // frames copied and waiting for a thread; 0 = 8 per thread
-    int sync_batch_frames = 16; // frames.csv rows made durable together ...
-    int sync_interval_ms = 200; // ... or after this long, whichever comes first
-};
-
-// What a RecordingWriter did, for the summary.
-struct RecordingWriterStats {
-    int threads = 0;
-    int png_compression = 0;
-    int queue_frames = 0;
-    int64_t max_queued = 0; // most frames waiting at once
-    int64_t syncs = 0;      // batches of rows made durable
-    double encode_ms = 0;   // total PNG encoding time, all threads
-    double write_ms = 0;    // total time writing and fsync'ing image files, all threads
-};
-
 // Writes one recording folder. Frames are copied by the caller's thread and handed to a pool
 // of threads that encode each image to PNG and write it (temporary file, fsync, rename).
 // The frames.csv rows are appended in the order the frames were submitted, in batches:
 // the images of a batch are durable (data fsync'ed, folders fsync'ed for the renames)
 // before its rows are written, and the rows are fsync'ed. A frame without its row does not
 // exist; a row never names an image that a crash could lose.
-class RecordingWriter {
+class RecordingWriter : public RecordingSink {
 public:
     // Creates `dir` (and its parents) and frames.csv with its header; writes calibration.yml
     // (when `calibrationYaml` is not empty) and rig.yaml (when `rigYaml` is not empty).
@@ -58,7 +39,7 @@ public:
     RecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
                     const RecordingWriterOptions &options = {});
     // Finishes the frames submitted (errors are dropped: call finish() to see them).
-    ~RecordingWriter();
+    ~RecordingWriter() override;
     RecordingWriter(const RecordingWriter &) = delete;
     RecordingWriter &operator=(const RecordingWriter &) = delete;
 
@@ -73,19 +54,18 @@ public:
     // Copies the frame's images (the source may have its buffers back at once) and queues
     // them. When the queue is full: waits for room when `wait`, else returns false and
     // queues nothing. Throws the first write failure of an earlier frame.
-    bool submit(const LentFrame &frame, bool wait);
+    bool submit(const LentFrame &frame, bool wait) override;
     // The same with images the writer takes over (they must not be written to afterwards).
     bool submit(uint64_t sequence, int64_t timestampLeftNs, int64_t timestampRightNs, cv::Mat left, cv::Mat right, bool rgb,
                 bool wait);
     // Waits until every frame submitted is written and its row durable; throws the first
     // write failure (frames listed before it stay readable).
-    void finish();
+    void finish() override;
 
     // Frames whose rows are in frames.csv and durable.
-    int64_t frameCount() const;
+    int64_t frameCount() const override;
     const std::string &dir() const { return dir_; }
-    RecordingWriterStats stats() const;
-
+    RecordingWriterStats stats() const override;
 
 private:
     struct Pool;
@@ -104,9 +84,9 @@ struct RecordOptions {
     // wait for any other (files, simulation: nothing is lost).
     std::optional<bool> drop_when_behind;
     RecordingWriterOptions writer;
-    // "folder" (PNG + frames.csv) or "mcap": a rosbag2 bag (rosbag/rosbag_recording.hpp).
-    std::string format = "folder";
-    RosbagOptions rosbag;
+    // Where the pairs go: empty, the folder (folderRecordingSink); the command may choose
+    // another (`record --format mcap`: rosbag/rosbag_recording.hpp).
+    RecordingSinkFactory sink;
 };
 
 struct RecordResult {
@@ -121,12 +101,16 @@ struct RecordResult {
     std::string error;               // empty when the run ended normally
 };
 
-// Records rig.source into `dir`. The calibration written is the rig's calibration file,
-// else the source's own, else none. A failure of the source after the recording has started
+// The folder of PNG pairs and frames.csv: a RecordingWriter.
+RecordingSinkFactory folderRecordingSink();
+
+// Records rig.source into `dir` through options.sink. The calibration written is the rig's
+// calibration file, else the source's own, else none. The grabs are the pipeline's
+// (pipeline/source_grab.hpp), and so is the answer to whether the source is live. A failure of the source after the recording has started
 // ends the run and is returned in `error` (the frames already written stay readable);
 // failures before (folder refused, source cannot open) are thrown as binocle::Error.
 // `onFrame` gets the number of pairs taken from the source so far.
-// At the end the folder gets summary.json (recordingSummary) beside frames.csv.
+// At the end the folder gets summary.json (recordingSummary) beside what the sink wrote.
 RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
                        const std::function<void(int64_t frames)> &onFrame = {});
 

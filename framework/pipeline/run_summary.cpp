@@ -8,16 +8,6 @@ namespace binocle {
 
 using Json = nlohmann::ordered_json;
 
-bool sourceIsLive(const std::string &statistics) {
-    if (statistics.empty()) return false;
-    try {
-        const YAML::Node n = YAML::Load(statistics);
-        return n.IsMap() && n["live"] && n["live"].as<bool>(false);
-    } catch (const YAML::Exception &) {
-        return false;
-    }
-}
-
 namespace {
 
 // Frames a source lost before it could deliver them, from the counters of its

@@ -11,10 +11,6 @@
 
 namespace binocle {
 
-// Whether the source says its frames come on their own clock (cameras): the
-// `live: true` entry of its statistics (sdk/include/binocle/abi/source.h).
-bool sourceIsLive(const std::string &statistics);
-
 // rig, name, source, matcher, units and the runtime block as the run applies it.
 nlohmann::ordered_json runHeader(const RigConfig &rig, RuntimeOptions::Policy policy, bool live);
 

@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "pipeline/recorder.hpp"
 
 #include <chrono>
 #include <filesystem>
@@ -124,6 +125,13 @@ int64_t RosbagRecordingWriter::frameCount() const {
 RecordingWriterStats RosbagRecordingWriter::stats() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return stats_;
+}
+
+RecordingSinkFactory rosbagRecordingSink(const RosbagOptions &rosbag) {
+    return [rosbag](const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
+                    const RecordingWriterOptions &options) -> std::unique_ptr<RecordingSink> {
+        return std::make_unique<RosbagRecordingWriter>(dir, calibrationYaml, rigYaml, rosbag, options);
+    };
 }
 
 } // namespace binocle

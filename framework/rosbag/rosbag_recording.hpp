@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: MIT
-// `binocle record --format mcap`: the recorder's writer for a rosbag2 bag. The same
-// contract as RecordingWriter (pipeline/recorder.hpp) so that the recorder drives either:
-// submit() copies the pair and queues it (or refuses it when the queue is full and the
-// caller does not wait), one thread turns pairs into Image + CameraInfo messages of the
-// bag (RosbagWriter), finish() writes what is queued and closes the bag (summary, footer,
-// metadata.yaml). rig.yaml and calibration.yml go beside the bag, as in a folder recording.
+// `binocle record --format mcap`: the recorder's sink for a rosbag2 bag, a RecordingSink
+// (pipeline/recording_sink.hpp) as the folder's RecordingWriter is, so that the recorder
+// drives either: submit() copies the pair and queues it (or refuses it when the queue is
+// full and the caller does not wait), one thread turns pairs into Image + CameraInfo
+// messages of the bag (RosbagWriter), finish() writes what is queued and closes the bag
+// (summary, footer, metadata.yaml). rig.yaml and calibration.yml go beside the bag, as in
+// a folder recording.
 #pragma once
 
-#include "pipeline/recorder.hpp"
+#include "pipeline/recording_sink.hpp"
 #include "rosbag/rosbag_writer.hpp"
 
 #include <condition_variable>
@@ -17,19 +18,19 @@
 
 namespace binocle {
 
-class RosbagRecordingWriter {
+class RosbagRecordingWriter : public RecordingSink {
 public:
     RosbagRecordingWriter(const std::string &dir, const std::string &calibrationYaml, const std::string &rigYaml,
                           const RosbagOptions &rosbag, const RecordingWriterOptions &options = {});
-    ~RosbagRecordingWriter();
+    ~RosbagRecordingWriter() override;
     RosbagRecordingWriter(const RosbagRecordingWriter &) = delete;
     RosbagRecordingWriter &operator=(const RosbagRecordingWriter &) = delete;
 
-    bool submit(const LentFrame &frame, bool wait);
+    bool submit(const LentFrame &frame, bool wait) override;
     // Writes every pair submitted and closes the bag; throws the first write failure.
-    void finish();
-    int64_t frameCount() const; // the pairs a reader recovers (RosbagWriter::durablePairs)
-    RecordingWriterStats stats() const;
+    void finish() override;
+    int64_t frameCount() const override; // the pairs a reader recovers (RosbagWriter::durablePairs)
+    RecordingWriterStats stats() const override;
     const RosbagWriter &bag() const { return *bag_; }
 
 private:
@@ -50,5 +51,9 @@ private:
     RecordingWriterStats stats_;
     std::thread thread_;
 };
+
+// The bag as the recorder's sink (RecordOptions::sink); the bag refuses `rosbag` when
+// checkRosbagOptions does.
+RecordingSinkFactory rosbagRecordingSink(const RosbagOptions &rosbag);
 
 } // namespace binocle

@@ -1,15 +1,24 @@
 // SPDX-License-Identifier: MIT
-// RosbagRunOutput: a run's frames as ROS 2 messages (see rosbag_run_output.hpp).
+// RosbagFrameWriter: a run's frames as ROS 2 messages (see rosbag_run_output.hpp).
 #include "rosbag/rosbag_run_output.hpp"
+
+#include "core/error.hpp"
+#include "pipeline/pipeline.hpp"
 
 #include <cmath>
 
 namespace binocle {
 
-RosbagRunOutput::RosbagRunOutput(const std::string &dir, const RosbagOptions &options)
+RosbagFrameWriter::RosbagFrameWriter(const std::string &dir, const RosbagOptions &options)
     : writer_(dir, std::nullopt, options) {}
 
-void RosbagRunOutput::onFrame(const FrameResult &r, const StereoCalibration &calibration) {
+void RosbagFrameWriter::finish(nlohmann::ordered_json &) {
+    writer_.close();
+}
+
+void RosbagFrameWriter::write(const FrameResult &r) {
+    if (!r.calibration) throw Error("internal: a frame for the bag without the run's calibration");
+    const StereoCalibration &calibration = *r.calibration;
     const int64_t stampL = r.frame ? r.frame->raw().timestamp_left_ns : static_cast<int64_t>(r.index);
     const int64_t stampR = r.frame ? r.frame->raw().timestamp_right_ns : stampL;
     if (!r.rectified_left.empty() && !r.rectified_right.empty())

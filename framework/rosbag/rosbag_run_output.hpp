@@ -1,23 +1,26 @@
 // SPDX-License-Identifier: MIT
-// `binocle run --out DIR --mcap`: every finished frame into DIR/bag/ (a rosbag2
-// bag, RosbagWriter): the rectified pair, the disparity (stereo_msgs/DisparityImage), the
+// `binocle run --out DIR --mcap`: every finished frame into DIR/bag/ (a rosbag2 bag,
+// RosbagWriter): the rectified pair, the disparity (stereo_msgs/DisparityImage), the
 // cloud after the transforms (PointCloud2, metres, in the ground frame when a ground
-// transform ran) and the evaluators' figures (DiagnosticArray).
+// transform ran) and the evaluators' figures (DiagnosticArray). A FrameWriter
+// (pipeline/frame_writer.hpp) as the run's folder is: the command hands it to the pipeline
+// in RunOptions::writers, and the writer stage calls it after the folder's.
 #pragma once
 
-#include "pipeline/pipeline.hpp"
+#include "pipeline/frame_writer.hpp"
 #include "rosbag/rosbag_writer.hpp"
 
 namespace binocle {
 
-class RosbagRunOutput {
+class RosbagFrameWriter : public FrameWriter {
 public:
     // Creates `dir` (which must not exist or be empty).
-    explicit RosbagRunOutput(const std::string &dir, const RosbagOptions &options = {});
-    // One finished frame, on the writer stage; `calibration` is the run's (for f and T).
-    void onFrame(const FrameResult &frame, const StereoCalibration &calibration);
-    void close() { writer_.close(); }
-    const RosbagWriter &writer() const { return writer_; }
+    explicit RosbagFrameWriter(const std::string &dir, const RosbagOptions &options = {});
+    // One finished frame, on the writer stage (f and T from the frame's calibration).
+    void write(const FrameResult &frame) override;
+    // Closes the bag (summary, footer, metadata.yaml); a failure fails the run.
+    void finish(nlohmann::ordered_json &summary) override;
+    const RosbagWriter &bag() const { return writer_; }
 
 private:
     RosbagWriter writer_;

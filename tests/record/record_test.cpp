@@ -13,7 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <yaml-cpp/yaml.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <fcntl.h>
@@ -322,6 +324,43 @@ TEST(Record, KilledRecorderLeavesARecordingReadableToItsLastFrame) {
                   << " frame(s) in frames.csv, " << replayed.size() << " replayed bit for bit (" << images << " images, "
                   << leftovers << " temporary file(s) of the frame being written)\n";
     }
+}
+
+// The recorder takes pairs as the pipeline's acquire stage does (pipeline/source_grab.hpp):
+// a stop asked while the source is silent ends the recording as interrupted, with the pairs
+// already written, instead of waiting out the grab's timeout or failing on the source's
+// short timeouts; and whether to drop when behind comes from the source's own `live` word.
+TEST(Record, AStopWhileTheSourceIsSilentEndsTheRecordingAtOnce) {
+    binocle::PluginHost fixtures(std::vector<std::string>{BINOCLE_TEST_PLUGIN_DIR});
+    fixtures.scan();
+    TempDir dir;
+    // Two pairs, then every grab times out after 50 ms for ten minutes.
+    const binocle::RigConfig rig = binocle::rigFromNode(
+        YAML::Load("name: silent\nsource:\n  plugin: mock_source\n  frames: 100\n  live: true\n  fail_after: 2\n"
+                   "  fail_for_ms: 600000\n  fail_code: timeout\nmatcher:\n  plugin: mock_matcher\n"),
+        dir.str("rig.yaml"), fixtures);
+    std::atomic<bool> stop{false};
+    binocle::RecordOptions options;
+    options.progress = false;
+    options.grab_timeout_ms = 120000;
+    options.stop = &stop;
+    std::thread stopper([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        stop = true;
+    });
+    const auto t0 = std::chrono::steady_clock::now();
+    const binocle::RecordResult r = binocle::recordRig(rig, dir.str("rec"), options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stopper.join();
+    EXPECT_EQ(r.status, "interrupted") << r.error;
+    EXPECT_TRUE(r.error.empty()) << r.error;
+    EXPECT_EQ(r.grabbed, 2);
+    EXPECT_EQ(r.frames, 2);
+    EXPECT_TRUE(r.dropped_when_behind) << "the source says live: true";
+    EXPECT_LT(seconds, 60.0) << "the stop was seen only when the grab's timeout ran out";
+    const nlohmann::json summary = nlohmann::json::parse(readFile(dir.str("rec") + "/summary.json"));
+    EXPECT_EQ(summary["status"], "interrupted");
+    EXPECT_EQ(summary["lost"]["when_writers_behind"], "drop");
 }
 
 TEST(RecordingWriter, AFullQueueRefusesWithoutWaitingAndRowsKeepTheirOrder) {
