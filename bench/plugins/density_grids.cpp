@@ -11,7 +11,7 @@ namespace {
 class DensityGrids : public binocle::sdk::Evaluator {
 public:
     static std::vector<binocle_param_desc> parameters() { return {}; }
-    DensityGrids(const binocle::sdk::Params &, binocle::sdk::Host &host) : host_(host) {}
+    DensityGrids(const binocle::sdk::CheckedParams &, binocle::sdk::Host &host) : host_(host) {}
 
     void evaluate(const binocle_eval_input &in) override {
         const binocle::method::DensityGrids g = binocle::method::binCloud(binocle::method::CloudView(*in.cloud), spec_);

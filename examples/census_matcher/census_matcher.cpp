@@ -22,7 +22,9 @@ public:
                 Param::boolean("left_right_check", true).help("invalidate pixels whose right-to-left match disagrees by > 1 px")};
     }
 
-    Census(const binocle::sdk::Params &p, binocle::sdk::Host &)
+    // `p` holds the settings checked against the table above (a key the rig leaves out
+    // reads as its default): nothing of the table is restated here.
+    Census(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &)
         : window_(static_cast<int>(p.integer("window_px"))), maxDisparity_(static_cast<int>(p.integer("max_disparity_px"))),
           maxHamming_(static_cast<int>(p.integer("max_hamming"))), leftRight_(p.boolean("left_right_check")) {}
 

@@ -31,8 +31,8 @@ public:
     }
 
     // cv::StereoBM's speckle range is in 1/16 px: it filters the fixed-point map.
-    BlockMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &)
-        : OpenCvMatcher("bm", p, parameters(), cv::StereoMatcher::DISP_SCALE) {
+    BlockMatcher(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &)
+        : OpenCvMatcher("bm", p, cv::StereoMatcher::DISP_SCALE) {
         stereo_->setBlockSize(static_cast<int>(p.integer("block_size")));
         stereo_->setPreFilterType(p.string("pre_filter_type") == "xsobel" ? cv::StereoBM::PREFILTER_XSOBEL
                                                                            : cv::StereoBM::PREFILTER_NORMALIZED_RESPONSE);

@@ -7,7 +7,6 @@
 // is built as a plugin).
 #pragma once
 
-#include "common/param_check.hpp"
 
 #include <binocle/plugin.hpp>
 
@@ -128,12 +127,10 @@ public:
     }
 
 protected:
-    // Checks every setting against `table` and applies the shared ones.
+    // Applies the shared settings, checked by the SDK against the plugin's table.
     // speckleUnitsPerPixel: how many units of OpenCV's speckle range make one pixel.
-    OpenCvMatcher(std::string name, const sdk::Params &p, const std::vector<binocle_param_desc> &table,
-                  int speckleUnitsPerPixel)
+    OpenCvMatcher(std::string name, const sdk::CheckedParams &p, int speckleUnitsPerPixel)
         : name_(std::move(name)), stereo_(OpenCvStereo::create()) {
-        checkParameters(p, table, name_);
         stereo_->setMinDisparity(static_cast<int>(p.integer("min_disparity")));
         stereo_->setNumDisparities(static_cast<int>(p.integer("num_disparities")));
         stereo_->setPreFilterCap(static_cast<int>(p.integer("pre_filter_cap")));

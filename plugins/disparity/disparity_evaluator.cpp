@@ -162,12 +162,10 @@ public:
         };
     }
 
-    DisparityEvaluator(const binocle::sdk::Params &p, binocle::sdk::Host &host)
+    DisparityEvaluator(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host)
         : host_(host), thresholds_(parseThresholds(p.string("thresholds_px"))), require_(p.boolean("require_ground_truth")) {
         if (thresholds_.empty() || thresholds_.size() > 16)
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "disparity evaluator: thresholds_px '" + p.string("thresholds_px") +
-                                                          "' is not valid: expected a list of 1 to 16 numbers >= 0 in px, "
-                                                          "e.g. [0.5, 1, 2, 4]");
+            p.refuse("thresholds_px", p.string("thresholds_px"), "a list of 1 to 16 numbers >= 0 in px, e.g. [0.5, 1, 2, 4]");
         total_.all.bad.assign(thresholds_.size(), 0);
         total_.nonocc.bad.assign(thresholds_.size(), 0);
     }

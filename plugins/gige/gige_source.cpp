@@ -10,8 +10,6 @@
 #include "pixel_formats.hpp"
 #include "reconnection.hpp"
 
-#include "common/param_check.hpp"
-
 #include <binocle/plugin.hpp>
 #include <opencv2/core.hpp>
 #include <yaml-cpp/yaml.h>
@@ -88,8 +86,7 @@ public:
         };
     }
 
-    GigeSource(const sdk::Params &p, sdk::Host &host) : host_(host), notifier_(std::make_shared<Notifier>()) {
-        plugins::checkParameters(p, parameters(), "gige");
+    GigeSource(const sdk::CheckedParams &p, sdk::Host &host) : host_(host), notifier_(std::make_shared<Notifier>()) {
         sideBySide_ = p.string("layout") == "side_by_side";
         const PixelFormat *format = findPixelFormat(p.string("pixel_format"));
         if (!format)

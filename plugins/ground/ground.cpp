@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: MIT
 // ground: CloudTransform moving a cloud from the camera frame into the ground frame (Eq. 1).
-#include "common/param_check.hpp"
 #include "ground/ground_frame.hpp"
 
 #include <binocle/plugin.hpp>
@@ -24,7 +23,8 @@ public:
         };
     }
 
-    GroundTransform(const binocle::sdk::Params &p, binocle::sdk::Host &) : frame_(frameOf(p)) {}
+    GroundTransform(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &)
+        : frame_(p.real("camera_height_mm"), p.real("inclination_deg")) {}
 
     void apply(binocle_cloud &cloud) override {
         if (cloud.frame == BINOCLE_FRAME_GROUND)
@@ -50,11 +50,6 @@ public:
     }
 
 private:
-    static binocle::ground::GroundFrame frameOf(const binocle::sdk::Params &p) {
-        binocle::plugins::checkParameters(p, parameters(), "ground");
-        return {p.real("camera_height_mm"), p.real("inclination_deg")};
-    }
-
     binocle::ground::GroundFrame frame_;
 };
 

@@ -3,7 +3,6 @@
 // ground-frame cloud and scores Eq. 2-6; Experiment 2: ground-plane and known-object
 // indicators. Both report the form factor (Eq. 7), the sensor-aware figures and the
 // objects localised in the density grids.
-#include "common/param_check.hpp"
 #include "method/density_grid.hpp"
 #include "method/density_render.hpp"
 #include "method/design.hpp"
@@ -36,7 +35,7 @@ using binocle::sdk::Param;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // "[a, b]" of a DOUBLE_LIST setting as an interval with a < b.
-method::Extent interval(const binocle::sdk::Params &p, const char *key) {
+method::Extent interval(const binocle::sdk::CheckedParams &p, const char *key) {
     const std::string text = p.string(key);
     std::vector<double> v;
     try {
@@ -45,12 +44,11 @@ method::Extent interval(const binocle::sdk::Params &p, const char *key) {
         v.clear();
     }
     if (v.size() != 2 || !(v[0] < v[1]) || !std::isfinite(v[0]) || !std::isfinite(v[1]))
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                    std::string("paper: ") + key + " = " + text + ": expected [min, max] in mm with min < max");
+        p.refuse(key, text, "[min, max] in mm with min < max");
     return {v[0], v[1]};
 }
 
-std::optional<std::vector<double>> triple(const binocle::sdk::Params &p, const char *key) {
+std::optional<std::vector<double>> triple(const binocle::sdk::CheckedParams &p, const char *key) {
     const std::string text = p.string(key);
     std::vector<double> v;
     try {
@@ -60,8 +58,7 @@ std::optional<std::vector<double>> triple(const binocle::sdk::Params &p, const c
     }
     if (v.empty()) return std::nullopt;
     if (v.size() != 3)
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                    std::string("paper: ") + key + " = " + text + ": expected [X, Y, Z] in mm, or [] for none");
+        p.refuse(key, text, "[X, Y, Z] in mm, or [] for none");
     return v;
 }
 
@@ -142,8 +139,7 @@ public:
         };
     }
 
-    PaperEvaluator(const binocle::sdk::Params &p, binocle::sdk::Host &host) : host_(host), p_(p) {
-        binocle::plugins::checkParameters(p, parameters(), "paper");
+    PaperEvaluator(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host) : host_(host), p_(p) {
         e2_ = p.string("experiment") == "e2";
         grid_.cell_mm = p.real("cell_size_mm");
         grid_.density_threshold = static_cast<int>(p.integer("density_threshold"));
@@ -525,9 +521,8 @@ private:
     }
 
     binocle::sdk::Host &host_;
-    // Numbers and flags only after the constructor: the host owns the settings' strings
-    // for the duration of create, so every string setting is copied there.
-    binocle::sdk::Params p_;
+    // The checked settings, a copy (strings included) kept for every frame.
+    binocle::sdk::CheckedParams p_;
     std::string objectName_;
     bool e2_ = false;
     method::GridSpec grid_;

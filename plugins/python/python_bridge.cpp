@@ -284,9 +284,8 @@ void importModule(Module &m) {
     m.cls = cls.release();
 }
 
-// An instance of the module's class, given the checked settings.
-Ref makeInstance(Module &m, const binocle::sdk::Params &p) {
-    const binocle::sdk::CheckedParams c(p, m.params, m.name);
+// An instance of the module's class, given the settings the SDK checked against the table.
+Ref makeInstance(Module &m, const binocle::sdk::CheckedParams &c) {
     std::lock_guard<std::mutex> lock(m.importing); // taken before the GIL, never while holding it
     Gil gil;
     if (!m.cls) importModule(m);
@@ -324,7 +323,7 @@ class PyMatcher : public binocle::sdk::Matcher {
 public:
     static std::vector<binocle_param_desc> parameters() { return module().params; }
 
-    PyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &) : m_(module()), instance_(makeInstance(m_, p)) {}
+    PyMatcher(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &) : m_(module()), instance_(makeInstance(m_, p)) {}
 
     ~PyMatcher() override { dropAll(instance_, leftBytes_, rightBytes_); }
 
@@ -439,7 +438,7 @@ class PyEvaluator : public binocle::sdk::Evaluator {
 public:
     static std::vector<binocle_param_desc> parameters() { return module().params; }
 
-    PyEvaluator(const binocle::sdk::Params &p, binocle::sdk::Host &host)
+    PyEvaluator(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host)
         : m_(module()), host_(host), instance_(makeInstance(m_, p)) {}
 
     ~PyEvaluator() override { dropAll(instance_); }

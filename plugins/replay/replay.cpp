@@ -96,10 +96,9 @@ struct Settings {
 std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
 
 // The table above is the one home of each setting's default, bounds and choices: the
-// SDK's checker reads `p` against it (a setting the host did not pass is its default).
-// Only the rules it cannot state are written here.
-Settings readSettings(const sdk::Params &p) {
-    const sdk::CheckedParams c(p, parameterTable(), "replay");
+// SDK checked `c` against it before the constructor (a setting the host did not pass is
+// its default). Only the rules it cannot state are written here.
+Settings readSettings(const sdk::CheckedParams &c) {
     Settings s;
     // An unset PATH is empty whatever the host made of the empty default.
     auto path = [&](const char *name, std::string &out) {
@@ -516,7 +515,7 @@ class ReplaySource : public sdk::StereoSource {
 public:
     static std::vector<binocle_param_desc> parameters() { return parameterTable(); }
 
-    ReplaySource(const sdk::Params &p, sdk::Host &host)
+    ReplaySource(const sdk::CheckedParams &p, sdk::Host &host)
         : host_(host), settings_(readSettings(p)), plan_(makePlan(settings_, host_)) {
         periodNs_ = static_cast<int64_t>(std::llround(1e9 / (settings_.rateHz > 0 ? settings_.rateHz : kNominalRateHz)));
         // A recording played in a loop keeps its time stamps increasing: each pass is

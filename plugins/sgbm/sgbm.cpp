@@ -35,15 +35,13 @@ public:
         });
     }
 
-    SemiGlobalMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host)
-        : OpenCvMatcher("sgbm", p, parameters(), 1) {
+    SemiGlobalMatcher(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host)
+        : OpenCvMatcher("sgbm", p, 1) {
         const int block = static_cast<int>(p.integer("block_size"));
         const Penalty p1 = penalty(p, "p1", 8, block);
         const Penalty p2 = penalty(p, "p2", 32, block);
         if (p2.value <= p1.value)
-            throw binocle::sdk::Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                                      "sgbm: p2 = " + p2.text() + ": expected more than p1 = " + p1.text() +
-                                          " (cv::StereoSGBM needs p2 > p1)");
+            p.refuse("p2", p2.text(), "more than p1 = " + p1.text() + " (cv::StereoSGBM needs p2 > p1)");
         stereo_->setBlockSize(block);
         stereo_->setP1(p1.value);
         stereo_->setP2(p2.value);
@@ -102,7 +100,7 @@ private:
 
     // The value set in the rig, else OpenCV's rule of thumb factor * channels *
     // block_size^2, with one channel since the pair is matched in grey.
-    static Penalty penalty(const binocle::sdk::Params &p, const char *key, int factor, int block) {
+    static Penalty penalty(const binocle::sdk::CheckedParams &p, const char *key, int factor, int block) {
         const int64_t v = p.integer(key);
         if (p.isExplicit(key) && v > 0) return {static_cast<int>(v), "set"};
         return {factor * block * block, "derived: " + std::to_string(factor) + " * block_size^2"};

@@ -64,10 +64,9 @@ public:
         };
     }
 
-    SgmMatcher(const binocle::sdk::Params &params, binocle::sdk::Host &host) {
-        // The SDK's settings checker: defaults, ranges, odd sizes, multiples and choices
-        // read from the table above, in the words every plugin uses.
-        const binocle::sdk::CheckedParams p(params, parameters(), "sgm");
+    // `p` is checked by the SDK against the table above (defaults, ranges, odd sizes,
+    // multiples and choices, refused in the words every plugin uses).
+    SgmMatcher(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host) {
         sgm::Settings s;
         s.minDisparity = static_cast<int>(p.integer("min_disparity"));
         s.numDisparities = static_cast<int>(p.integer("num_disparities"));

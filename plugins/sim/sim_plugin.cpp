@@ -9,7 +9,6 @@
 #include "scene.hpp"
 
 #include "common/frame_pacer.hpp"
-#include "common/param_check.hpp"
 
 #include <binocle/plugin.hpp>
 #include <yaml-cpp/yaml.h>
@@ -30,7 +29,7 @@ using sdk::Error;
 using sdk::Param;
 
 // A DOUBLE_LIST setting: `count` numbers (or one of `alternatives` counts).
-std::vector<double> numberList(const sdk::Params &p, const std::string &key, std::initializer_list<size_t> counts) {
+std::vector<double> numberList(const sdk::CheckedParams &p, const std::string &key, std::initializer_list<size_t> counts) {
     const std::string text = p.string(key);
     std::vector<double> v;
     try {
@@ -38,14 +37,13 @@ std::vector<double> numberList(const sdk::Params &p, const std::string &key, std
         if (!n.IsSequence()) throw YAML::Exception(YAML::Mark::null_mark(), "not a list");
         for (const auto &item : n) v.push_back(item.as<double>());
     } catch (const YAML::Exception &) {
-        throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "sim: " + key + " = " + text + ": expected a list of numbers");
+        p.refuse(key, text, "a list of numbers");
     }
     for (size_t c : counts)
         if (v.size() == c) return v;
     std::string expected;
     for (size_t c : counts) expected += (expected.empty() ? "" : " or ") + std::to_string(c);
-    throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
-                "sim: " + key + " = " + text + ": expected a list of " + expected + " numbers, got " + std::to_string(v.size()));
+    p.refuse(key, text, "a list of " + expected + " numbers, got " + std::to_string(v.size()));
 }
 
 sim::Distortion distortionOf(const std::vector<double> &v) {
@@ -59,11 +57,11 @@ sim::Vec3 vec3Of(const std::vector<double> &v) { return {v[0], v[1], v[2]}; }
 // Settings copied as they are into the member of the same name (a key of the sim is the
 // name of the RigSettings or RenderSettings member it sets): one table, one loop.
 template <class Settings>
-void readWholeNumbers(const sdk::Params &p, Settings &s, std::initializer_list<std::pair<const char *, int Settings::*>> members) {
+void readWholeNumbers(const sdk::CheckedParams &p, Settings &s, std::initializer_list<std::pair<const char *, int Settings::*>> members) {
     for (const auto &[key, member] : members) s.*member = static_cast<int>(p.integer(key));
 }
 template <class Settings>
-void readReals(const sdk::Params &p, Settings &s, std::initializer_list<std::pair<const char *, double Settings::*>> members) {
+void readReals(const sdk::CheckedParams &p, Settings &s, std::initializer_list<std::pair<const char *, double Settings::*>> members) {
     for (const auto &[key, member] : members) s.*member = p.real(key);
 }
 
@@ -118,8 +116,7 @@ public:
         };
     }
 
-    SimSource(const sdk::Params &p, sdk::Host &host) : host_(host) {
-        checkParameters(p, parameters(), "sim");
+    SimSource(const sdk::CheckedParams &p, sdk::Host &host) : host_(host) {
         using Rig = sim::RigSettings;
         Rig rig;
         readWholeNumbers(p, rig, {{"image_width", &Rig::image_width}, {"image_height", &Rig::image_height}});

@@ -69,10 +69,9 @@ std::string number(double v) {
 }
 
 // The table above is the one home of each setting's default, bounds and choices: the
-// SDK's checker reads `p` against it (a setting the host did not pass is its default).
-// Only the rules across settings are written here.
-Settings readSettings(const sdk::Params &p) {
-    const sdk::CheckedParams c(p, V4l2Source::parameters(), "v4l2");
+// SDK checked `c` against it before the constructor (a setting the host did not pass is
+// its default). Only the rules across settings are written here.
+Settings readSettings(const sdk::CheckedParams &c) {
     Settings s;
     s.sideBySide = c.string("layout") == "side_by_side";
     s.deviceLeft = c.string("device_left");
@@ -134,7 +133,7 @@ int64_t nowNs() {
 
 // ---- The source --------------------------------------------------------------------------------
 
-V4l2Source::V4l2Source(const sdk::Params &params, sdk::Host &host) : host_(host), settings_(readSettings(params)) {
+V4l2Source::V4l2Source(const sdk::CheckedParams &params, sdk::Host &host) : host_(host), settings_(readSettings(params)) {
     if (settings_.sideBySide) {
         streams_.push_back(openStream(settings_.deviceLeft, "side_by_side"));
     } else {

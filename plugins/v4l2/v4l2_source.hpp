@@ -37,7 +37,7 @@ class V4l2Source : public sdk::StereoSource {
 public:
     static std::vector<binocle_param_desc> parameters();
     // Opens the device(s) and negotiates the format; buffers are requested at start.
-    V4l2Source(const sdk::Params &params, sdk::Host &host);
+    V4l2Source(const sdk::CheckedParams &params, sdk::Host &host);
     ~V4l2Source() override;
 
     void start() override;

@@ -75,9 +75,9 @@ std::string describe(const CameraInfo &c) {
 bool isVidere(const CameraInfo &c) { return lower(c.vendor).find("videre") != std::string::npos; }
 
 // The table above is the one home of each setting's default, bounds and choices: the
-// SDK's checker reads `p` against it (a setting the host did not pass is its default).
-Settings readSettings(const sdk::Params &p) {
-    const sdk::CheckedParams c(p, VidereSource::parameters(), "videre1394");
+// SDK checked `c` against it before the constructor (a setting the host did not pass is
+// its default).
+Settings readSettings(const sdk::CheckedParams &c) {
     Settings s;
     s.guid = c.string("guid");
     s.videoMode = c.string("video_mode");
@@ -236,7 +236,7 @@ private:
 
 // ---- The source ------------------------------------------------------------------------------
 
-VidereSource::VidereSource(const sdk::Params &params, sdk::Host &host)
+VidereSource::VidereSource(const sdk::CheckedParams &params, sdk::Host &host)
     : host_(host), settings_(readSettings(params)) {
     std::vector<CameraInfo> cameras;
     try {

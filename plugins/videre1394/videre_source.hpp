@@ -54,7 +54,7 @@ public:
     static std::vector<binocle_param_desc> parameters();
     // Finds and opens the head, selects the mode and reads its stored calibration;
     // the DMA ring is set up at start.
-    VidereSource(const sdk::Params &params, sdk::Host &host);
+    VidereSource(const sdk::CheckedParams &params, sdk::Host &host);
     ~VidereSource() override;
 
     void start() override;

@@ -174,8 +174,15 @@ TEST(DisparityEvaluator, AGroundTruthBeyondTheWidthOrBadThresholdsAreRefused) {
     } catch (const std::exception &e) {
         EXPECT_NE(std::string(e.what()).find("image width 8"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(EvalRun("{thresholds_px: [1, x]}"), std::exception);
-    EXPECT_THROW(EvalRun("{thresholds_px: [-1]}"), std::exception);
+    for (const char *bad : {"[1, x]", "[-1]", "[]"}) {
+        try {
+            EvalRun(std::string("{thresholds_px: ") + bad + "}");
+            FAIL() << "accepted thresholds_px " << bad;
+        } catch (const std::exception &e) { // the one form of a refused setting (binocle/settings.hpp)
+            EXPECT_NE(std::string(e.what()).find("disparity: thresholds_px = "), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(": expected a list of 1 to 16 numbers >= 0 in px"), std::string::npos) << e.what();
+        }
+    }
 }
 
 } // namespace

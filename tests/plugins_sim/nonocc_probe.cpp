@@ -25,7 +25,7 @@ cv::Mat viewOf(const binocle_image &im, int type) {
 class NonoccProbe : public binocle::sdk::Evaluator {
 public:
     static std::vector<binocle_param_desc> parameters() { return {}; }
-    NonoccProbe(const binocle::sdk::Params &, binocle::sdk::Host &host) : host_(host) {}
+    NonoccProbe(const binocle::sdk::CheckedParams &, binocle::sdk::Host &host) : host_(host) {}
 
     void evaluate(const binocle_eval_input &in) override {
         std::map<std::string, const binocle_image *> extras;

@@ -48,7 +48,7 @@ foreach(required include/binocle/abi.h include/binocle/abi/common.h include/bino
   endif()
 endforeach()
 foreach(file IN LISTS installed)
-  if(NOT file MATCHES "^include/binocle/(abi\\.h|abi/[a-z_]+\\.h|plugin\\.hpp|recording\\.hpp|text\\.hpp|mcap\\.hpp|ros2_messages\\.hpp|settings\\.hpp|numbers\\.hpp)$"
+  if(NOT file MATCHES "^include/binocle/(abi\\.h|abi/[a-z_]+\\.h|plugin\\.hpp|error\\.hpp|recording\\.hpp|text\\.hpp|mcap\\.hpp|ros2_messages\\.hpp|settings\\.hpp|numbers\\.hpp)$"
      AND NOT file MATCHES "/cmake/Binocle/[A-Za-z_-]+\\.cmake$" AND NOT file MATCHES "^lib[^/]*/libbinocle_mcap\\.a$"
      # the Python bridge, copied per Python plugin by binocle_add_python_plugin
      AND NOT file MATCHES "^lib[^/]*/binocle/python/binocle_python_bridge\\.so$")

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The SDK's one number reader and settings checker (binocle/numbers.hpp,
 // binocle/settings.hpp), as a third-party plugin uses them: no framework code here.
+// Also the settings a plugin's constructor gets through the SDK's `create` (plugin.hpp):
+// checked ones, or the raw ones for a constructor written before that.
+#include <binocle/plugin.hpp>
 #include <binocle/settings.hpp>
 
 #include <gtest/gtest.h>
@@ -222,6 +225,77 @@ TEST(CheckedParams, ABadDefaultIsThePluginsMistakeAndSaysSo) {
                   std::string::npos)
             << e.what();
     }
+}
+
+// ---- What `create` hands a plugin's constructor (plugin.hpp) ---------------------------
+
+// Written the one way: the constructor takes the settings the SDK checked against the table.
+class CheckedMatcher : public Matcher {
+public:
+    static std::vector<binocle_param_desc> parameters() { return table(); }
+    CheckedMatcher(const CheckedParams &p, Host &) : block(p.integer("block_size")), mode(p.string("mode")) {}
+    void compute(const binocle_image &, const binocle_image &, binocle_image &) override {}
+    int64_t block;
+    std::string mode;
+};
+
+// Written against the SDK before it built CheckedParams: the raw values, still built.
+class RawMatcher : public Matcher {
+public:
+    static std::vector<binocle_param_desc> parameters() { return table(); }
+    RawMatcher(const Params &p, Host &) : passedBlock(p.has("block_size")) {}
+    void compute(const binocle_image &, const binocle_image &, binocle_image &) override {}
+    bool passedBlock;
+};
+
+static_assert(detail::takesCheckedParams<CheckedMatcher> && !detail::takesRawParams<CheckedMatcher>);
+static_assert(detail::takesRawParams<RawMatcher> && !detail::takesCheckedParams<RawMatcher>);
+
+// An instance made through the plugin's C table, as the host makes it.
+template <class T>
+struct Made {
+    const binocle_matcher_api *api = detail::matcherTable<T>("my_matcher", "1.0.0", "a test matcher");
+    binocle_matcher *handle = nullptr;
+    binocle_result rc = BINOCLE_OK;
+    std::string error;
+    explicit Made(std::vector<binocle_param> values) {
+        rc = api->create(values.data(), static_cast<int32_t>(values.size()), nullptr, &handle);
+        if (rc != BINOCLE_OK) error = api->last_error(nullptr);
+    }
+    Made(const Made &) = delete;
+    Made &operator=(const Made &) = delete;
+    ~Made() {
+        if (handle) api->destroy(handle);
+    }
+    T &impl() { return *reinterpret_cast<detail::MatcherInstance<T> *>(handle)->impl; }
+};
+
+TEST(PluginSettings, AConstructorTakingCheckedParamsGetsDefaultsFilledIn) {
+    Made<CheckedMatcher> made({intParam("block_size", 7)});
+    ASSERT_EQ(made.rc, BINOCLE_OK) << made.error;
+    EXPECT_EQ(made.impl().block, 7);
+    EXPECT_EQ(made.impl().mode, "bm"); // not passed: the table's default
+    Made<CheckedMatcher> none({});
+    ASSERT_EQ(none.rc, BINOCLE_OK) << none.error;
+    EXPECT_EQ(none.impl().block, 5);
+}
+
+TEST(PluginSettings, AConstructorTakingRawParamsStillBuildsAndGetsTheValuesAsPassed) {
+    Made<RawMatcher> made({intParam("block_size", 7)});
+    ASSERT_EQ(made.rc, BINOCLE_OK) << made.error;
+    EXPECT_TRUE(made.impl().passedBlock);
+    Made<RawMatcher> none({});
+    ASSERT_EQ(none.rc, BINOCLE_OK) << none.error;
+    EXPECT_FALSE(none.impl().passedBlock);
+}
+
+TEST(PluginSettings, AValueOutsideTheTableFailsCreateBeforeEitherConstructorRuns) {
+    for (const std::string &error : {Made<CheckedMatcher>({intParam("block_size", 8)}).error,
+                                     Made<RawMatcher>({intParam("block_size", 8)}).error})
+        EXPECT_EQ(error, "my_matcher: block_size = 8: expected an odd integer >= 1");
+    Made<CheckedMatcher> bad({intParam("num_disparities", 100)});
+    EXPECT_EQ(bad.rc, BINOCLE_ERR_INVALID_ARGUMENT);
+    EXPECT_EQ(bad.handle, nullptr);
 }
 
 } // namespace

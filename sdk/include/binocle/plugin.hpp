@@ -7,10 +7,17 @@
 //           return {binocle::sdk::Param::integer("window_px", "5").min(1).odd()
 //                       .help("matching window").unit("px")};
 //       }
-//       MyMatcher(const binocle::sdk::Params &p, binocle::sdk::Host &host);
+//       MyMatcher(const binocle::sdk::CheckedParams &p, binocle::sdk::Host &host)
+//           : window_(static_cast<int>(p.integer("window_px"))) {}
 //       void compute(const binocle_image &l, const binocle_image &r, binocle_image &d) override;
 //   };
 //   BINOCLE_EXPORT_MATCHER(MyMatcher, "my_matcher", "1.0.0", "What it does")
+//
+// The constructor gets the settings checked against parameters() (settings.hpp): a
+// setting the host did not pass reads as its default, and a value outside the table
+// fails `create` with "my_matcher: window_px = 4: expected an odd integer >= 1". A
+// constructor taking `const Params &` (the raw values, as earlier SDKs handed them)
+// still builds, and is called after the same check.
 //
 // Exceptions thrown by the class are caught at the boundary and turned into a result
 // code (binocle::sdk::Error carries its own) and a message the host can ask for.
@@ -18,6 +25,8 @@
 #pragma once
 
 #include <binocle/abi.h>
+#include <binocle/error.hpp>
+#include <binocle/settings.hpp>
 
 #include <cstring>
 #include <exception>
@@ -27,93 +36,11 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace binocle::sdk {
-
-// An error with a result code; anything else thrown becomes BINOCLE_ERR_INTERNAL.
-class Error : public std::runtime_error {
-public:
-    Error(binocle_result code, const std::string &message) : std::runtime_error(message), code_(code) {}
-    binocle_result code() const noexcept { return code_; }
-
-private:
-    binocle_result code_;
-};
-
-// ---- Settings -------------------------------------------------------------------
-
-// Builder for binocle_param_desc. All strings must be literals (static storage).
-class Param {
-public:
-    static Param boolean(const char *name, bool def) { return Param(name, BINOCLE_PARAM_BOOL, def ? "true" : "false"); }
-    static Param integer(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT, def); }
-    static Param real(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE, def); }
-    static Param string(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_STRING, def); }
-    static Param path(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_PATH, def); }
-    static Param yaml(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_YAML, def); }
-    static Param intList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT_LIST, def); }
-    static Param realList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE_LIST, def); }
-    // choices: "a|b|c"
-    static Param choice(const char *name, const char *def, const char *choices) {
-        Param p(name, BINOCLE_PARAM_ENUM, def);
-        p.d_.choices = choices;
-        return p;
-    }
-    // A setting without default that the YAML must give.
-    Param &required() { d_.flags |= BINOCLE_PARAM_FLAG_REQUIRED; d_.default_value = nullptr; return *this; }
-    Param &min(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MIN; d_.min = v; return *this; }
-    Param &max(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MAX; d_.max = v; return *this; }
-    Param &odd() { d_.flags |= BINOCLE_PARAM_FLAG_ODD; return *this; }
-    // A resource limit (memory, time): the rig or --set sets it, a live page cannot.
-    Param &limit() { d_.flags |= BINOCLE_PARAM_FLAG_LIMIT; return *this; }
-    Param &multipleOf(int64_t m) { d_.multiple_of = m; return *this; }
-    Param &unit(const char *u) { d_.unit = u; return *this; }
-    Param &help(const char *h) { d_.help = h; return *this; }
-    operator binocle_param_desc() const { return d_; } // NOLINT: meant to convert
-
-private:
-    Param(const char *name, int32_t type, const char *def) {
-        d_.name = name;
-        d_.type = type;
-        d_.default_value = def;
-        d_.unit = "";
-        d_.help = "";
-    }
-    binocle_param_desc d_{};
-};
-
-// Read access to validated settings, by name.
-class Params {
-public:
-    Params(const binocle_param *params, int32_t count) {
-        for (int32_t i = 0; i < count; ++i) byName_[params[i].name] = params[i];
-    }
-    bool has(const std::string &name) const { return byName_.count(name) != 0; }
-    // True when the user set the value (YAML or --set), false for defaults.
-    bool isExplicit(const std::string &name) const { return get(name).explicit_ != 0; }
-    int64_t integer(const std::string &name) const { return get(name).i; }
-    bool boolean(const std::string &name) const { return get(name).i != 0; }
-    double real(const std::string &name) const {
-        const binocle_param &p = get(name);
-        return p.type == BINOCLE_PARAM_INT ? static_cast<double>(p.i) : p.d;
-    }
-    // STRING, ENUM, PATH, YAML and lists (as YAML text).
-    std::string string(const std::string &name) const {
-        const char *s = get(name).s;
-        return s ? s : "";
-    }
-
-private:
-    const binocle_param &get(const std::string &name) const {
-        auto it = byName_.find(name);
-        if (it == byName_.end())
-            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "no setting named '" + name + "' (plugin bug: not declared)");
-        return it->second;
-    }
-    std::map<std::string, binocle_param> byName_;
-};
 
 // ---- Host services -----------------------------------------------------------------
 
@@ -324,14 +251,41 @@ const std::vector<binocle_param_desc> &paramsOf() {
     return p;
 }
 
+// The plugin's name as its table gives it (set when the table is made, which the host
+// asks for before any `create`): refusals of its settings start with it.
+template <class T>
+std::string &pluginNameOf() {
+    static std::string name;
+    return name;
+}
+
+// Which settings a plugin class's constructor takes: `const CheckedParams &` (the one
+// way, what the in-tree plugins do) or `const Params &` (the SDK before CheckedParams
+// was built for the plugin; still built, so a plugin written then keeps compiling).
+template <class T>
+constexpr bool takesCheckedParams = std::is_constructible_v<T, const CheckedParams &, Host &>;
+template <class T>
+constexpr bool takesRawParams = std::is_constructible_v<T, const Params &, Host &>;
+
+// The plugin's instance, made from settings checked against its table first.
+template <class T>
+std::unique_ptr<T> makePlugin(const Params &raw, Host &host) {
+    static_assert(takesCheckedParams<T> || takesRawParams<T>,
+                  "a plugin class needs a constructor T(const binocle::sdk::CheckedParams &, binocle::sdk::Host &)");
+    const CheckedParams checked(raw, paramsOf<T>(), pluginNameOf<T>());
+    if constexpr (takesCheckedParams<T>)
+        return std::make_unique<T>(checked, host);
+    else
+        return std::make_unique<T>(raw, host);
+}
+
 template <class Inst, class Handle>
 binocle_result create(const binocle_param *params, int32_t n, const binocle_host *host, Handle **out) noexcept {
     if (!out) return BINOCLE_ERR_INVALID_ARGUMENT;
     *out = nullptr;
     return guard(createError(), [&] {
         auto inst = std::make_unique<Inst>(host);
-        Params p(params, n);
-        inst->impl = std::make_unique<typename Inst::Impl>(p, inst->hostView);
+        inst->impl = makePlugin<typename Inst::Impl>(Params(params, n), inst->hostView);
         *out = reinterpret_cast<Handle *>(inst.release());
     });
 }
@@ -536,6 +490,7 @@ template <class Table, class T, class Wrapper, class Handle>
 Table tableOf(int32_t kind, const char *name, const char *version, const char *description) {
     Table t{};
     t.header = header(sizeof(t), kind, name, version, description);
+    pluginNameOf<T>() = name ? name : "";
     t.params = paramsOf<T>().data();
     t.param_count = static_cast<int32_t>(paramsOf<T>().size());
     t.create = &create<Wrapper, Handle>;

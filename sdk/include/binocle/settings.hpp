@@ -1,16 +1,19 @@
 // SPDX-License-Identifier: MIT
-// The one settings checker, header-only: how the text of a setting reads and whether a
-// value fits its binocle_param_desc (type, min, max, odd, multiple of, choices). The host
-// checks every rig setting, `runtime:` key, isolation key and --set with it, and a plugin
-// reads what `create` received through CheckedParams, so the same value gets the same
-// answer in a rig file, on the command line and inside a plugin, in the same words.
+// A plugin's settings, header-only: how it declares them (Param, its table of
+// binocle_param_desc), the one settings checker (how the text of a setting reads and
+// whether a value fits its description: type, min, max, odd, multiple of, choices) and
+// CheckedParams, the values `create` received checked against the table. The host
+// checks every rig setting, `runtime:` key, isolation key and --set with this checker,
+// and the SDK hands a plugin's constructor its CheckedParams (plugin.hpp), so the same
+// value gets the same answer in a rig file, on the command line and inside a plugin, in
+// the same words.
 //
 // Numbers follow binocle/numbers.hpp: decimal only, "0100" and "0x10" are errors.
 #pragma once
 
 #include <binocle/abi.h>
+#include <binocle/error.hpp>
 #include <binocle/numbers.hpp>
-#include <binocle/plugin.hpp>
 #include <binocle/text.hpp>
 
 #include <cmath>
@@ -23,6 +26,78 @@
 #include <vector>
 
 namespace binocle::sdk {
+
+// Builder for binocle_param_desc. All strings must be literals (static storage).
+class Param {
+public:
+    static Param boolean(const char *name, bool def) { return Param(name, BINOCLE_PARAM_BOOL, def ? "true" : "false"); }
+    static Param integer(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT, def); }
+    static Param real(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE, def); }
+    static Param string(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_STRING, def); }
+    static Param path(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_PATH, def); }
+    static Param yaml(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_YAML, def); }
+    static Param intList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_INT_LIST, def); }
+    static Param realList(const char *name, const char *def) { return Param(name, BINOCLE_PARAM_DOUBLE_LIST, def); }
+    // choices: "a|b|c"
+    static Param choice(const char *name, const char *def, const char *choices) {
+        Param p(name, BINOCLE_PARAM_ENUM, def);
+        p.d_.choices = choices;
+        return p;
+    }
+    // A setting without default that the YAML must give.
+    Param &required() { d_.flags |= BINOCLE_PARAM_FLAG_REQUIRED; d_.default_value = nullptr; return *this; }
+    Param &min(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MIN; d_.min = v; return *this; }
+    Param &max(double v) { d_.flags |= BINOCLE_PARAM_FLAG_HAS_MAX; d_.max = v; return *this; }
+    Param &odd() { d_.flags |= BINOCLE_PARAM_FLAG_ODD; return *this; }
+    // A resource limit (memory, time): the rig or --set sets it, a live page cannot.
+    Param &limit() { d_.flags |= BINOCLE_PARAM_FLAG_LIMIT; return *this; }
+    Param &multipleOf(int64_t m) { d_.multiple_of = m; return *this; }
+    Param &unit(const char *u) { d_.unit = u; return *this; }
+    Param &help(const char *h) { d_.help = h; return *this; }
+    operator binocle_param_desc() const { return d_; } // NOLINT: meant to convert
+
+private:
+    Param(const char *name, int32_t type, const char *def) {
+        d_.name = name;
+        d_.type = type;
+        d_.default_value = def;
+        d_.unit = "";
+        d_.help = "";
+    }
+    binocle_param_desc d_{};
+};
+
+// The values `create` received, by name, as the host passed them. A plugin reads
+// CheckedParams instead (below): the SDK builds it from this before the constructor.
+class Params {
+public:
+    Params(const binocle_param *params, int32_t count) {
+        for (int32_t i = 0; i < count; ++i) byName_[params[i].name] = params[i];
+    }
+    bool has(const std::string &name) const { return byName_.count(name) != 0; }
+    // True when the user set the value (YAML or --set), false for defaults.
+    bool isExplicit(const std::string &name) const { return get(name).explicit_ != 0; }
+    int64_t integer(const std::string &name) const { return get(name).i; }
+    bool boolean(const std::string &name) const { return get(name).i != 0; }
+    double real(const std::string &name) const {
+        const binocle_param &p = get(name);
+        return p.type == BINOCLE_PARAM_INT ? static_cast<double>(p.i) : p.d;
+    }
+    // STRING, ENUM, PATH, YAML and lists (as YAML text).
+    std::string string(const std::string &name) const {
+        const char *s = get(name).s;
+        return s ? s : "";
+    }
+
+private:
+    const binocle_param &get(const std::string &name) const {
+        auto it = byName_.find(name);
+        if (it == byName_.end())
+            throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "no setting named '" + name + "' (plugin bug: not declared)");
+        return it->second;
+    }
+    std::map<std::string, binocle_param> byName_;
+};
 
 // 1500, 0.5, -90, 3600000: as short as the number allows, whole numbers in full.
 inline std::string settingNumberText(double v) {
@@ -227,11 +302,13 @@ inline std::string settingMessage(const std::string &plugin, const std::string &
 // The settings `create` received, checked against the plugin's own table: a setting the
 // host did not pass reads as its default, every value fits its description, and asking
 // for a name the table lacks is a plugin bug. Throws Error(BINOCLE_ERR_INVALID_ARGUMENT,
-// settingMessage(...)). A plugin reads its settings through this instead of restating
-// its table (defaults, bounds, choices) in code:
+// settingMessage(...)). The SDK builds it from the plugin's parameters() before the
+// constructor runs (a refusal fails `create` in these words) and hands it to a
+// constructor that takes one, so a plugin reads its settings without restating its
+// table (defaults, bounds, choices) in code:
 //
-//   const sdk::CheckedParams c(params, parameters(), "my_matcher");
-//   window_ = static_cast<int>(c.integer("window_px"));
+//   MyMatcher(const sdk::CheckedParams &p, sdk::Host &)
+//       : window_(static_cast<int>(p.integer("window_px"))) {}
 class CheckedParams {
 public:
     CheckedParams(const Params &params, const std::vector<binocle_param_desc> &table, std::string plugin)
@@ -306,3 +383,8 @@ private:
 };
 
 } // namespace binocle::sdk
+
+// This header brought plugin.hpp with it before Param and Params moved here: kept, so
+// that a plugin that includes only settings.hpp still compiles. plugin.hpp includes
+// this header first, so either order defines everything.
+#include <binocle/plugin.hpp>

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 // external_matcher: a plugin built outside the Binocle tree with the installed SDK only;
-// writes disparity_px wherever the left pixel is not black.
+// writes disparity_px wherever the left pixel is not black. Its constructor takes the raw
+// `sdk::Params`, as plugins written before the SDK built their `CheckedParams` did: that
+// form must keep compiling (with -Werror) and running. New plugins take
+// `const sdk::CheckedParams &` (examples/census_matcher).
 #include <binocle/plugin.hpp>
 // The header-only helpers compile from the installed SDK alone, too.
 #include <binocle/recording.hpp>
