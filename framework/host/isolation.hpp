@@ -82,7 +82,8 @@ public:
 
 protected:
     // A restart's cost is the kind's (PluginKind::lostOnRestart).
-    PluginProxy(const PluginRecord &record, const ParamValues &params, const binocle_host *host);
+    PluginProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                const binocle_host *host);
     struct Reply {
         int32_t rc = 0;
         std::string message;
@@ -142,8 +143,9 @@ private:
 template <class Impl>
 class Proxied : public Impl, protected PluginProxy {
 public:
-    Proxied(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : PluginProxy(record, params, host.get()) {
+    Proxied(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+            const std::shared_ptr<binocle_host> &host)
+        : PluginProxy(record, params, isolation, host.get()) {
         launchOrThrow();
     }
     bool isolated() const override { return true; }

@@ -114,8 +114,9 @@ uint8_t *SharedRegion::reserve(size_t bytes) {
 
 // ---- PluginProxy ---------------------------------------------------------
 
-PluginProxy::PluginProxy(const PluginRecord &record, const ParamValues &params, const binocle_host *host)
-    : record_(record), params_(params), options_(params.isolation()), host_(host), kind_(pluginKind(record.kind)) {}
+PluginProxy::PluginProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                         const binocle_host *host)
+    : record_(record), params_(params), options_(isolation), host_(host), kind_(pluginKind(record.kind)) {}
 
 PluginProxy::~PluginProxy() { stopHelper(); }
 
@@ -345,7 +346,7 @@ PluginRecord describeInHelper(const std::string &path, int32_t timeout_ms) {
     file.name = fs::path(path).stem().string();
     if (file.name.rfind("binocle_", 0) == 0) file.name = file.name.substr(8);
     struct Describer : PluginProxy {
-        Describer(const PluginRecord &r) : PluginProxy(r, ParamValues(), nullptr) {}
+        Describer(const PluginRecord &r) : PluginProxy(r, ParamValues(), IsolationOptions(), nullptr) {}
     } d(file);
     try {
         d.spawn();

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 // The evaluator kind: its descriptor, its instance in this process, behind a proxy, and
 // in the helper process, and the Evaluator wrapper.
+#include "host/kind_evaluator.hpp"
+
+#include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
 #include "host/isolation.hpp"
-#include "host/plugin_instance.hpp"
 #include "host/plugin_kinds.hpp"
 
 namespace binocle {
@@ -43,8 +45,9 @@ public:
 // restart loses the figures of that frame and whatever the plugin had gathered.
 class EvaluatorProxy : public Proxied<Evaluator::Impl> {
 public:
-    EvaluatorProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : Proxied(record, params, host), shared_(record.name, 0) {}
+    EvaluatorProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                   const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, isolation, host), shared_(record.name, 0) {}
     void evaluate(const binocle_eval_input &in) override {
         // The calibration and the rig change rarely: sent again only when they did, or to
         // a helper process that has not had them.
@@ -103,9 +106,10 @@ private:
 
 // ---- The wrapper ------------------------------------------------------------------------------
 
-Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink) : PluginInstanceBase(record) {
+Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink, const IsolationOptions &isolation)
+    : PluginInstanceBase(record) {
     setSink(std::move(sink)); // before create: what it logs goes there already
-    impl_ = choose<Impl, InProcessEvaluator, EvaluatorProxy>(record_, params);
+    impl_ = choose<Impl, InProcessEvaluator, EvaluatorProxy>(record_, params, isolation);
 }
 
 Evaluator::~Evaluator() = default;
