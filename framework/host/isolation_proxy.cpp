@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The proxy: the host's end of a plugin instance that runs in a helper process (spawn,
 // calls with a watchdog, restarts), its shared memory, and files described by a helper
-// process. The other end is isolated_side.cpp; what crosses is isolation_codec.cpp's.
+// process. The other end is isolated_side.cpp; what crosses is the ipc_*.hpp
+// messages and the kinds' own (kind_<name>_messages.hpp).
 #include "host/isolation.hpp"
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "host/child_process.hpp"
 #include "host/install_prefix.hpp"
+#include "host/ipc_transport.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <algorithm>

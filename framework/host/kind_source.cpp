@@ -5,6 +5,7 @@
 
 #include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
+#include "host/kind_source_messages.hpp"
 #include "host/isolation.hpp"
 #include "host/plugin_kinds.hpp"
 
