@@ -50,8 +50,7 @@ void run(benchmark::State &state, const binocle::PluginRecord *record, const std
     binocle::IsolationOptions o;
     o.process = state.range(0) == 1;
     o.call_timeout_ms = 10000;
-    params.setIsolation(o);
-    binocle::Matcher matcher(*record, params);
+    binocle::Matcher matcher(*record, params, o);
     for (auto _ : state) {
         cv::Mat d = matcher.compute(f.left, f.right);
         benchmark::DoNotOptimize(d.data);
@@ -73,8 +72,7 @@ void BM_IsolationSource640x480(benchmark::State &state) {
     binocle::IsolationOptions o;
     o.process = state.range(0) == 1;
     o.call_timeout_ms = 10000;
-    params.setIsolation(o);
-    binocle::Source source(*record, params);
+    binocle::Source source(*record, params, o);
     source.start();
     for (auto _ : state) {
         std::unique_ptr<binocle::LentFrame> frame = source.grab(1000);

@@ -145,7 +145,7 @@ struct SourcePairs {
 // Pairs from the rig's source: every frame, or (live) those where the board is still.
 void pairsFromSource(StereoCalibrator &calibrator, const RigConfig &rig, const SourcePairs &how, const CalibrationOptions &options,
                      const std::string &boardText) {
-    Source source(*rig.source().record, rig.source().params);
+    Source source(*rig.source().record, rig.source().params, rig.source().isolation);
     spdlog::info("binocle calibrate: {} board, {} mm squares, pairs from source '{}'{}", boardText, options.board.square_mm,
                  rig.source().plugin,
                  how.live ? " (live: a pair is taken when the board has been still for " + std::to_string(how.stillFrames) + " frames)"

@@ -326,7 +326,7 @@ PluginBlock block(const YAML::Node &node, const std::string &where, int32_t kind
                                            " (available: " + (all.empty() ? "none" : all) + ")" + refused);
     }
     b.params = resolveWith(*b.record, node, where, ctx);
-    b.params.setIsolation(isolation);
+    b.isolation = isolation;
     return b;
 }
 

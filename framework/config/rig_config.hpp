@@ -30,6 +30,7 @@ struct PluginBlock {
     std::string plugin; // plugin name
     const PluginRecord *record = nullptr;
     ParamValues params;
+    IsolationOptions isolation; // how its instances run (`isolation: process` ...)
     Location location;
 };
 

@@ -42,7 +42,7 @@ BoardCalibrationOutcome calibrateConfiguration(const YAML::Node &testRig, const 
     for (const auto &[path, value] : spec.capture)
         applyOverride(captureRig, Override{path, value, "board_calibration.capture: " + path});
     const RigConfig rig = rigFromNode(captureRig, rigFile, host);
-    Source source(*rig.source().record, rig.source().params);
+    Source source(*rig.source().record, rig.source().params, rig.source().isolation);
 
     BoardCalibrationOutcome out;
     out.file = calibrationFile;

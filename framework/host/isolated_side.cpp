@@ -3,6 +3,7 @@
 // serves its instance over the socket (each kind's calls by its ServedInstance), and
 // forwards what it logs, prints and reports.
 #include "host/isolated_side.hpp"
+#include "host/ipc_transport.hpp"
 #include "host/isolation.hpp"
 #include "host/plugin_kinds.hpp"
 

@@ -3,7 +3,9 @@
 // instance, and each kind answers its own calls (kind_<name>.cpp). Internal to host/.
 #pragma once
 
-#include "host/isolation_codec.hpp"
+#include "host/ipc_messages.hpp"
+#include "host/ipc_planes.hpp"
+#include "host/ipc_wire.hpp"
 #include "host/plugin_host.hpp"
 
 #include <cstdint>

@@ -2,11 +2,13 @@
 // Plugins out of process (libcamera's IPA isolation is the model): files examined in
 // short-lived children, and instances of any kind run in a helper process
 // (binocle-plugin-helper) behind a proxy. Words: the *helper process* runs the plugin;
-// the *proxy* (PluginProxy) is its host-side end; the *codec* (isolation_codec.hpp)
+// the *proxy* (PluginProxy) is its host-side end; the *codec* (ipc_*.hpp, kind_*_messages.hpp)
 // encodes what crosses; the *isolated side* (isolated_side.cpp) serves the calls.
 #pragma once
 
-#include "host/isolation_codec.hpp"
+#include "host/ipc_messages.hpp"
+#include "host/ipc_planes.hpp"
+#include "host/ipc_wire.hpp"
 #include "host/plugin_host.hpp"
 
 #include <functional>
@@ -82,7 +84,8 @@ public:
 
 protected:
     // A restart's cost is the kind's (PluginKind::lostOnRestart).
-    PluginProxy(const PluginRecord &record, const ParamValues &params, const binocle_host *host);
+    PluginProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                const binocle_host *host);
     struct Reply {
         int32_t rc = 0;
         std::string message;
@@ -142,8 +145,9 @@ private:
 template <class Impl>
 class Proxied : public Impl, protected PluginProxy {
 public:
-    Proxied(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : PluginProxy(record, params, host.get()) {
+    Proxied(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+            const std::shared_ptr<binocle_host> &host)
+        : PluginProxy(record, params, isolation, host.get()) {
         launchOrThrow();
     }
     bool isolated() const override { return true; }

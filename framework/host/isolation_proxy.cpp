@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The proxy: the host's end of a plugin instance that runs in a helper process (spawn,
 // calls with a watchdog, restarts), its shared memory, and files described by a helper
-// process. The other end is isolated_side.cpp; what crosses is isolation_codec.cpp's.
+// process. The other end is isolated_side.cpp; what crosses is the ipc_*.hpp
+// messages and the kinds' own (kind_<name>_messages.hpp).
 #include "host/isolation.hpp"
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "host/child_process.hpp"
 #include "host/install_prefix.hpp"
+#include "host/ipc_transport.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <algorithm>
@@ -114,8 +116,9 @@ uint8_t *SharedRegion::reserve(size_t bytes) {
 
 // ---- PluginProxy ---------------------------------------------------------
 
-PluginProxy::PluginProxy(const PluginRecord &record, const ParamValues &params, const binocle_host *host)
-    : record_(record), params_(params), options_(params.isolation()), host_(host), kind_(pluginKind(record.kind)) {}
+PluginProxy::PluginProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                         const binocle_host *host)
+    : record_(record), params_(params), options_(isolation), host_(host), kind_(pluginKind(record.kind)) {}
 
 PluginProxy::~PluginProxy() { stopHelper(); }
 
@@ -345,7 +348,7 @@ PluginRecord describeInHelper(const std::string &path, int32_t timeout_ms) {
     file.name = fs::path(path).stem().string();
     if (file.name.rfind("binocle_", 0) == 0) file.name = file.name.substr(8);
     struct Describer : PluginProxy {
-        Describer(const PluginRecord &r) : PluginProxy(r, ParamValues(), nullptr) {}
+        Describer(const PluginRecord &r) : PluginProxy(r, ParamValues(), IsolationOptions(), nullptr) {}
     } d(file);
     try {
         d.spawn();

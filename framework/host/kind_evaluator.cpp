@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The evaluator kind: its descriptor, its instance in this process, behind a proxy, and
 // in the helper process, and the Evaluator wrapper.
+#include "host/kind_evaluator.hpp"
+
+#include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
+#include "host/kind_evaluator_messages.hpp"
 #include "host/isolation.hpp"
-#include "host/plugin_instance.hpp"
 #include "host/plugin_kinds.hpp"
 
 namespace binocle {
@@ -43,8 +46,9 @@ public:
 // restart loses the figures of that frame and whatever the plugin had gathered.
 class EvaluatorProxy : public Proxied<Evaluator::Impl> {
 public:
-    EvaluatorProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : Proxied(record, params, host), shared_(record.name, 0) {}
+    EvaluatorProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                   const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, isolation, host), shared_(record.name, 0) {}
     void evaluate(const binocle_eval_input &in) override {
         // The calibration and the rig change rarely: sent again only when they did, or to
         // a helper process that has not had them.
@@ -101,11 +105,74 @@ private:
 
 } // namespace
 
+// ---- What crosses to the helper process (kind_evaluator_messages.hpp) ----------------------
+
+namespace wire {
+
+void putEvaluate(Writer &w, Layout &layout, const binocle_eval_input &in, bool sendCalibration, bool sendRig) {
+    w.put<uint8_t>(in.frame != nullptr);
+    if (in.frame) putFrame(w, layout, *in.frame);
+    for (const binocle_image *im : {in.rectified_left, in.rectified_right, in.disparity}) {
+        w.put<uint8_t>(im != nullptr);
+        if (im) putImage(w, layout.place(*im));
+    }
+    w.put<uint8_t>(in.cloud != nullptr);
+    if (in.cloud) putCloud(w, layout, *in.cloud);
+    // A text the helper process has already: a byte that says "the same as before".
+    w.put<uint8_t>(!sendCalibration);
+    if (sendCalibration) w.cstr(in.calibration_yaml);
+    w.put<uint8_t>(!sendRig);
+    if (sendRig) w.cstr(in.rig_yaml);
+    w.cstr(in.output_dir);
+    // What the host knows of the matcher's search and the ground pose (appended members).
+    w.put<int32_t>(in.min_disparity).put<int32_t>(in.num_disparities).put<int32_t>(in.ground_pose_known);
+    w.put<double>(in.camera_height_mm).put<double>(in.inclination_deg);
+    // The matcher's planes (appended members).
+    putNamedImages(w, layout, in.disparity_extras, in.disparity_extras ? in.disparity_extra_count : 0);
+}
+
+void getEvaluate(Reader &r, Region region, EvaluateTexts &texts, EvaluateInput &out) {
+    const bool hasFrame = r.get<uint8_t>() != 0;
+    if (hasFrame) out.frame = getFrame(r, region, out.frameTexts);
+    bool has[3];
+    for (int i = 0; i < 3; ++i) {
+        has[i] = r.get<uint8_t>() != 0;
+        if (has[i]) out.images[i] = getImage(r, region);
+    }
+    const bool hasCloud = r.get<uint8_t>() != 0;
+    if (hasCloud) out.cloud = getCloud(r, region);
+    for (auto *text : {&texts.calibration, &texts.rig})
+        if (r.get<uint8_t>() == 0) *text = r.cstr(); // else: the same as before
+    out.output = r.cstr();
+    binocle_eval_input &in = out.in;
+    in = binocle_eval_input{};
+    in.min_disparity = r.get<int32_t>();
+    in.num_disparities = r.get<int32_t>();
+    in.ground_pose_known = r.get<int32_t>();
+    in.camera_height_mm = r.get<double>();
+    in.inclination_deg = r.get<double>();
+    getNamedImages(r, region, out.disparityExtras);
+    in.disparity_extras = out.disparityExtras.images.empty() ? nullptr : out.disparityExtras.images.data();
+    in.disparity_extra_count = static_cast<int32_t>(out.disparityExtras.images.size());
+    in.struct_size = sizeof in;
+    in.frame = hasFrame ? &out.frame : nullptr;
+    in.rectified_left = has[0] ? &out.images[0] : nullptr;
+    in.rectified_right = has[1] ? &out.images[1] : nullptr;
+    in.disparity = has[2] ? &out.images[2] : nullptr;
+    in.cloud = hasCloud ? &out.cloud : nullptr;
+    in.calibration_yaml = texts.calibration.first ? texts.calibration.second.c_str() : nullptr;
+    in.rig_yaml = texts.rig.first ? texts.rig.second.c_str() : nullptr;
+    in.output_dir = out.output.first ? out.output.second.c_str() : nullptr;
+}
+
+} // namespace wire
+
 // ---- The wrapper ------------------------------------------------------------------------------
 
-Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink) : PluginInstanceBase(record) {
+Evaluator::Evaluator(const PluginRecord &record, const ParamValues &params, HostSink sink, const IsolationOptions &isolation)
+    : PluginInstanceBase(record) {
     setSink(std::move(sink)); // before create: what it logs goes there already
-    impl_ = choose<Impl, InProcessEvaluator, EvaluatorProxy>(record_, params);
+    impl_ = choose<Impl, InProcessEvaluator, EvaluatorProxy>(record_, params, isolation);
 }
 
 Evaluator::~Evaluator() = default;

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The matcher kind: its descriptor, its instance in this process, behind a proxy, and in
 // the helper process, and the Matcher wrapper that checks what any of them computes.
+#include "host/kind_matcher.hpp"
+
+#include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
+#include "host/kind_matcher_messages.hpp"
 #include "host/isolation.hpp"
-#include "host/plugin_instance.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <cmath>
@@ -103,8 +106,9 @@ public:
 
 class MatcherProxy : public Proxied<Matcher::Impl> {
 public:
-    MatcherProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : Proxied(record, params, host), shared_(record.name, 0) {}
+    MatcherProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                 const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, isolation, host), shared_(record.name, 0) {}
     void compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity, std::vector<NamedPlane> &extras) override {
         extras.clear();
         wire::ComputeRequest c{left.cols, left.rows, left.type(), 0, 0};
@@ -183,8 +187,8 @@ public:
 
 // ---- The wrapper ------------------------------------------------------------------------------
 
-Matcher::Matcher(const PluginRecord &record, const ParamValues &params)
-    : PluginInstanceBase(record), impl_(choose<Impl, InProcessMatcher, MatcherProxy>(record_, params)) {}
+Matcher::Matcher(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation)
+    : PluginInstanceBase(record), impl_(choose<Impl, InProcessMatcher, MatcherProxy>(record_, params, isolation)) {}
 
 Matcher::~Matcher() = default;
 

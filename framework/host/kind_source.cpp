@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The stereo source kind: its descriptor, its instance in this process, behind a proxy,
 // and in the helper process, and the Source wrapper.
+#include "host/kind_source.hpp"
+
+#include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
+#include "host/kind_source_messages.hpp"
 #include "host/isolation.hpp"
-#include "host/plugin_instance.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <mutex>
@@ -133,8 +136,9 @@ struct FrameCopy {
 // instance's first (a camera's next image; a file source begins again).
 class SourceProxy : public Proxied<Source::Impl> {
 public:
-    SourceProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : Proxied(record, params, host), slots_(std::make_shared<Slots>()) {
+    SourceProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, isolation, host), slots_(std::make_shared<Slots>()) {
         slots_->name = record.name;
     }
     void start() override {
@@ -234,8 +238,8 @@ private:
 
 // ---- The wrapper ------------------------------------------------------------------------------
 
-Source::Source(const PluginRecord &record, const ParamValues &params)
-    : PluginInstanceBase(record), impl_(choose<Impl, InProcessSource, SourceProxy>(record_, params)) {}
+Source::Source(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation)
+    : PluginInstanceBase(record), impl_(choose<Impl, InProcessSource, SourceProxy>(record_, params, isolation)) {}
 
 Source::~Source() = default;
 

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The cloud transform kind: its descriptor, its instance in this process, behind a proxy,
 // and in the helper process, and the CloudTransform wrapper.
+#include "host/kind_transform.hpp"
+
+#include "host/instance_support.hpp"
 #include "host/isolated_side.hpp"
+#include "host/kind_transform_messages.hpp"
 #include "host/isolation.hpp"
-#include "host/plugin_instance.hpp"
 #include "host/plugin_kinds.hpp"
 
 namespace binocle {
@@ -44,8 +47,9 @@ public:
 
 class TransformProxy : public Proxied<CloudTransform::Impl> {
 public:
-    TransformProxy(const PluginRecord &record, const ParamValues &params, const std::shared_ptr<binocle_host> &host)
-        : Proxied(record, params, host), shared_(record.name, 0) {}
+    TransformProxy(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation,
+                   const std::shared_ptr<binocle_host> &host)
+        : Proxied(record, params, isolation, host), shared_(record.name, 0) {}
     // The cloud's arrays cross in shared memory and come back rewritten; after a restart
     // the cloud of that frame is dropped (count 0). The helper's wrapper checked the cloud.
     void apply(binocle_cloud &cloud) override {
@@ -92,8 +96,8 @@ public:
 
 // ---- The wrapper ------------------------------------------------------------------------------
 
-CloudTransform::CloudTransform(const PluginRecord &record, const ParamValues &params)
-    : PluginInstanceBase(record), impl_(choose<Impl, InProcessTransform, TransformProxy>(record_, params)) {}
+CloudTransform::CloudTransform(const PluginRecord &record, const ParamValues &params, const IsolationOptions &isolation)
+    : PluginInstanceBase(record), impl_(choose<Impl, InProcessTransform, TransformProxy>(record_, params, isolation)) {}
 
 CloudTransform::~CloudTransform() = default;
 

@@ -1,65 +1,15 @@
 // SPDX-License-Identifier: MIT
-// What every plugin instance has: its settings (ParamValues), its binocle_host and sink,
-// the error of a failed call, image checks and views, and the frames a source lends.
+// What every plugin instance has: its binocle_host and sink, the choice of where it runs,
+// the error of a failed call, image checks and views (host/instance_support.hpp).
 #include "host/plugin_instance.hpp"
 
 #include "core/log.hpp"
+#include "host/instance_support.hpp"
 
 #include <sstream>
 #include <spdlog/spdlog.h>
 
 namespace binocle {
-
-// ---- Settings -------------------------------------------------------------------------------
-
-binocle_param &ParamValues::slot(const std::string &name) {
-    for (auto &p : values_)
-        if (name == p.name) return p;
-    strings_.push_back(std::make_shared<std::string>(name));
-    binocle_param p{};
-    p.name = strings_.back()->c_str();
-    values_.push_back(p);
-    return values_.back();
-}
-
-void ParamValues::setBool(const std::string &name, bool v, bool isExplicit) {
-    auto &p = slot(name);
-    p.type = BINOCLE_PARAM_BOOL;
-    p.i = v ? 1 : 0;
-    p.explicit_ = isExplicit;
-}
-
-void ParamValues::setInt(const std::string &name, int64_t v, bool isExplicit) {
-    auto &p = slot(name);
-    p.type = BINOCLE_PARAM_INT;
-    p.i = v;
-    p.d = static_cast<double>(v);
-    p.explicit_ = isExplicit;
-}
-
-void ParamValues::setDouble(const std::string &name, double v, bool isExplicit) {
-    auto &p = slot(name);
-    p.type = BINOCLE_PARAM_DOUBLE;
-    p.d = v;
-    p.explicit_ = isExplicit;
-}
-
-void ParamValues::setText(const std::string &name, int32_t type, const std::string &v, bool isExplicit) {
-    auto &p = slot(name);
-    strings_.push_back(std::make_shared<std::string>(v));
-    p.type = type;
-    p.s = strings_.back()->c_str();
-    p.explicit_ = isExplicit;
-}
-
-const binocle_param *ParamValues::data() const { return values_.data(); }
-int32_t ParamValues::size() const { return static_cast<int32_t>(values_.size()); }
-
-const binocle_param *ParamValues::find(const std::string &name) const {
-    for (const auto &p : values_)
-        if (name == p.name) return &p;
-    return nullptr;
-}
 
 // ---- Instances ---------------------------------------------------------------------------------
 
@@ -122,8 +72,8 @@ PluginInstanceBase::PluginInstanceBase(const PluginRecord &record) : record_(rec
 
 void PluginInstanceBase::setSink(HostSink sink) { reinterpret_cast<HostBlock *>(host_.get())->ctx.sink = std::move(sink); }
 
-bool PluginInstanceBase::runsIsolated(const PluginRecord &record, const ParamValues &params) {
-    return params.isolation().process || record.described;
+bool PluginInstanceBase::runsIsolated(const PluginRecord &record, const IsolationOptions &isolation) {
+    return isolation.process || record.described;
 }
 
 void failCall(const PluginRecord &record, const std::string &what, int32_t code, const char *message) {
@@ -202,38 +152,6 @@ std::string checkFrame(const binocle_stereo_frame &f) {
         bad = checkImage(f.extras[i].image, ("extra plane '" + name + "'").c_str());
     }
     return bad;
-}
-
-// ---- LentFrame ---------------------------------------------------------------------------------
-
-LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_source_api *api, binocle_source *src,
-                     const binocle_stereo_frame &f)
-    : keep_(std::move(keep)), api_(api), src_(src), frame_(f) {}
-
-LentFrame::LentFrame(std::shared_ptr<void> keep, const binocle_stereo_frame &f)
-    : keep_(std::move(keep)), api_(nullptr), src_(nullptr), frame_(f) {}
-
-LentFrame::~LentFrame() {
-    if (!api_) return; // keep_ holds the copy; dropping it is the release
-    try {
-        const int32_t rc = api_->release_frame(src_, frame_.frame_id);
-        if (rc != BINOCLE_OK) {
-            const char *why = api_->last_error(src_);
-            spdlog::error("source plugin '{}': release_frame of frame {} (sequence {}) failed ({}){}{}",
-                          api_->header.name ? api_->header.name : "?", frame_.frame_id,
-                          frame_.sequence, resultName(rc), why && *why ? ": " : "", why ? why : "");
-        }
-    } catch (...) {
-    }
-}
-
-cv::Mat LentFrame::left() const { return view(frame_.left); }
-cv::Mat LentFrame::right() const { return view(frame_.right); }
-
-cv::Mat LentFrame::extra(const std::string &name) const {
-    for (int32_t i = 0; i < frame_.extra_count; ++i)
-        if (frame_.extras[i].name && name == frame_.extras[i].name) return view(frame_.extras[i].image);
-    return {};
 }
 
 } // namespace binocle

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
-// Checks of a plugin's settings table (names, types, defaults), apart from loading: the
-// settings checker's home in the host.
+// A plugin's settings: the values an instance is made with (ParamValues), and the checks
+// of its settings table (names, types, defaults), apart from loading: the settings
+// checker's home in the host.
+#include "host/plugin_settings.hpp"
+
 #include "host/plugin_host.hpp"
 #include "host/plugin_name.hpp"
 #include "host/setting_json.hpp"
@@ -12,6 +15,57 @@
 #include <string>
 
 namespace binocle {
+
+// ---- Settings values ----------------------------------------------------------------------
+
+binocle_param &ParamValues::slot(const std::string &name) {
+    for (auto &p : values_)
+        if (name == p.name) return p;
+    strings_.push_back(std::make_shared<std::string>(name));
+    binocle_param p{};
+    p.name = strings_.back()->c_str();
+    values_.push_back(p);
+    return values_.back();
+}
+
+void ParamValues::setBool(const std::string &name, bool v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_BOOL;
+    p.i = v ? 1 : 0;
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setInt(const std::string &name, int64_t v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_INT;
+    p.i = v;
+    p.d = static_cast<double>(v);
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setDouble(const std::string &name, double v, bool isExplicit) {
+    auto &p = slot(name);
+    p.type = BINOCLE_PARAM_DOUBLE;
+    p.d = v;
+    p.explicit_ = isExplicit;
+}
+
+void ParamValues::setText(const std::string &name, int32_t type, const std::string &v, bool isExplicit) {
+    auto &p = slot(name);
+    strings_.push_back(std::make_shared<std::string>(v));
+    p.type = type;
+    p.s = strings_.back()->c_str();
+    p.explicit_ = isExplicit;
+}
+
+const binocle_param *ParamValues::data() const { return values_.data(); }
+int32_t ParamValues::size() const { return static_cast<int32_t>(values_.size()); }
+
+const binocle_param *ParamValues::find(const std::string &name) const {
+    for (const auto &p : values_)
+        if (name == p.name) return &p;
+    return nullptr;
+}
 
 // ---- Settings tables --------------------------------------------------------------------
 

@@ -87,10 +87,10 @@ Pipeline::Pipeline(const RigConfig &rig, const PluginHost &) : rig_(rig), instan
     auto &matchers = instances_->edit<Matcher>();
     auto &transforms = instances_->edit<CloudTransform>();
     auto &evaluators = instances_->edit<EvaluatorSlot>();
-    sources.push_back(std::make_unique<Source>(*rig.source().record, rig.source().params));
+    sources.push_back(std::make_unique<Source>(*rig.source().record, rig.source().params, rig.source().isolation));
     for (int i = 0; i < rig.runtime.matcher_instances; ++i)
-        matchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
-    for (const auto &t : rig.transforms()) transforms.push_back(std::make_unique<CloudTransform>(*t.record, t.params));
+        matchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params, rig.matcher().isolation));
+    for (const auto &t : rig.transforms()) transforms.push_back(std::make_unique<CloudTransform>(*t.record, t.params, t.isolation));
     for (const auto &e : rig.evaluators()) evaluators.push_back(makeEvaluator(e));
     disparityRange_ = askDisparityRange(*matchers.front());
 }
@@ -124,7 +124,7 @@ std::unique_ptr<Pipeline::EvaluatorSlot> Pipeline::makeEvaluator(const PluginBlo
     sink.text = [raw](const std::string &name, const std::string &text) {
         if (raw->target) (*raw->target)[name] = text;
     };
-    slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink);
+    slot->evaluator = std::make_unique<Evaluator>(*e.record, e.params, sink, e.isolation);
     return slot;
 }
 
@@ -151,17 +151,18 @@ void Pipeline::reconfigure(const RigConfig &rig) {
     std::vector<std::unique_ptr<CloudTransform>> nextTransforms(rig.transforms().size());
     std::vector<std::unique_ptr<EvaluatorSlot>> nextEvaluators(rig.evaluators().size());
     const bool newSource = !sameBlock(rig.source(), rig_.source()) || rig.calibration_file != rig_.calibration_file;
-    if (newSource) nextSource = std::make_unique<Source>(*rig.source().record, rig.source().params);
+    if (newSource) nextSource = std::make_unique<Source>(*rig.source().record, rig.source().params, rig.source().isolation);
     // As many instances as the stage has threads (runtime.matcher_instances is read when
     // the pipeline is made).
     const size_t matcherThreads = instances_->of<Matcher>().size();
     if (!sameBlock(rig.matcher(), rig_.matcher()))
         for (size_t i = 0; i < matcherThreads; ++i)
-            nextMatchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params));
+            nextMatchers.push_back(std::make_unique<Matcher>(*rig.matcher().record, rig.matcher().params, rig.matcher().isolation));
     const std::pair<int32_t, int32_t> range = nextMatchers.empty() ? disparityRange_ : askDisparityRange(*nextMatchers.front());
     for (size_t i = 0; i < rig.transforms().size(); ++i)
         if (i >= rig_.transforms().size() || !sameBlock(rig.transforms()[i], rig_.transforms()[i]))
-            nextTransforms[i] = std::make_unique<CloudTransform>(*rig.transforms()[i].record, rig.transforms()[i].params);
+            nextTransforms[i] = std::make_unique<CloudTransform>(*rig.transforms()[i].record, rig.transforms()[i].params,
+                                                                   rig.transforms()[i].isolation);
     for (size_t i = 0; i < rig.evaluators().size(); ++i)
         if (i >= rig_.evaluators().size() || !sameBlock(rig.evaluators()[i], rig_.evaluators()[i]))
             nextEvaluators[i] = makeEvaluator(rig.evaluators()[i]);

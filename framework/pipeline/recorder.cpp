@@ -8,7 +8,7 @@
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
-#include "host/plugin_instance.hpp"
+#include "host/instance_support.hpp"
 #include "pipeline/source_grab.hpp"
 
 #include <binocle/recording.hpp>
@@ -572,7 +572,7 @@ RecordResult recordInto(RecordingSink &sink, Source &source, const std::string &
 
 RecordResult recordRig(const RigConfig &rig, const std::string &dir, const RecordOptions &options,
                        const std::function<void(int64_t frames)> &onFrame) {
-    Source source(*rig.source().record, rig.source().params);
+    Source source(*rig.source().record, rig.source().params, rig.source().isolation);
     std::string calibration;
     if (rig.calibration_file) calibration = readTextFile(*rig.calibration_file);
     else calibration = source.calibration();

@@ -49,7 +49,7 @@ Rendered render(const std::string &rigText) {
     PluginHost host({BINOCLE_BUILD_PLUGIN_DIR});
     host.scan();
     const RigConfig rig = loadRig(dir.str("rig.yaml"), {}, host);
-    Source source(*rig.source().record, rig.source().params);
+    Source source(*rig.source().record, rig.source().params, rig.source().isolation);
     Rendered r;
     r.truth = StereoCalibration::fromYaml(source.calibration(), "sim");
     source.start();

@@ -1,7 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Every message of the isolation codec survives a round trip (encode, then decode gives
 // the same values and pixels), and a truncated or out-of-region message is refused.
-#include "host/isolation_codec.hpp"
+#include "host/ipc_messages.hpp"
+#include "host/ipc_planes.hpp"
+#include "host/ipc_wire.hpp"
+#include "host/kind_evaluator_messages.hpp"
+#include "host/kind_matcher_messages.hpp"
+#include "host/kind_source_messages.hpp"
+#include "host/kind_transform_messages.hpp"
 #include "host/plugin_kinds.hpp"
 
 #include <gmock/gmock.h>

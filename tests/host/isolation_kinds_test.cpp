@@ -33,8 +33,7 @@ std::unique_ptr<Instance> isolated(const std::string &name, int32_t kind, const 
     const PluginRecord &record = fixture(name, kind);
     ParamValues params = paramsFromYaml(record, yaml);
     o.process = true;
-    params.setIsolation(o);
-    return std::make_unique<Instance>(record, params, std::forward<Extra>(extra)...);
+    return std::make_unique<Instance>(record, params, std::forward<Extra>(extra)..., o);
 }
 
 cv::Mat copyOf(const cv::Mat &m) { return m.clone(); }

@@ -18,8 +18,7 @@ std::unique_ptr<Matcher> isolatedMatcher(const std::string &name, const std::str
     const PluginRecord &record = fixture(name, BINOCLE_KIND_MATCHER);
     ParamValues params = paramsFromYaml(record, yaml);
     o.process = true;
-    params.setIsolation(o);
-    return std::make_unique<Matcher>(record, params);
+    return std::make_unique<Matcher>(record, params, o);
 }
 
 // Wall-clock bounds are loose on purpose: CI machines are shared. They prove that a crash
@@ -82,8 +81,7 @@ TEST(Isolation, ThePluginsOwnErrorsCrossWithTheirCode) {
     bad.setText("mode", BINOCLE_PARAM_ENUM, "nonsense");
     IsolationOptions o;
     o.process = true;
-    bad.setIsolation(o);
-    EXPECT_NO_THROW(Matcher(record, bad)); // mock_matcher treats unknown modes as constant
+    EXPECT_NO_THROW(Matcher(record, bad, o)); // mock_matcher treats unknown modes as constant
 }
 
 TEST(Isolation, ACrashInComputeNamesPluginCallAndSignal) {
