@@ -81,7 +81,13 @@ TEST(Isolation, ThePluginsOwnErrorsCrossWithTheirCode) {
     bad.setText("mode", BINOCLE_PARAM_ENUM, "nonsense");
     IsolationOptions o;
     o.process = true;
-    EXPECT_NO_THROW(Matcher(record, bad, o)); // mock_matcher treats unknown modes as constant
+    // The SDK checks the settings against the plugin's table before its constructor runs
+    // (even one that takes raw Params, as mock_matcher's does): the refusal crosses from the
+    // helper with the plugin's code and words, the same as in process.
+    const std::string isolated = pluginErrorOf([&] { Matcher(record, bad, o); });
+    EXPECT_THAT(isolated, HasSubstr("create failed (BINOCLE_ERR_INVALID_ARGUMENT): mock_matcher: mode = 'nonsense'"));
+    const std::string inProcess = pluginErrorOf([&] { Matcher(record, bad, IsolationOptions{}); });
+    EXPECT_EQ(isolated.substr(isolated.find("create failed")), inProcess.substr(inProcess.find("create failed")));
 }
 
 TEST(Isolation, ACrashInComputeNamesPluginCallAndSignal) {
