@@ -187,7 +187,7 @@ public:
 
         Drawings drawings;
         for (const method::LocalisedObject &o : objects)
-            drawings.top.push_back({{o.x_min_mm, o.x_max_mm}, {o.y_min_mm, o.y_max_mm}, "#" + std::to_string(o.id), {150, 90, 30}});
+            drawings.top.push_back({{o.x_min_mm, o.x_max_mm}, {o.y_min_mm, o.y_max_mm}, "#" + std::to_string(o.id), {150, 90, 30}, {}, 0});
         double range = kNaN;
         std::optional<method::PanelPlacement> panel;
         if (e2_) range = evaluateE2(cloud, truth, drawings);
@@ -213,6 +213,18 @@ private:
         double sum = 0;
         int64_t n = 0;
     };
+
+    // Eq. 2-6 of one reading, named with `suffix` after the quantity ("" for the matcher's
+    // cloud, "_oracle" for the ground truth's): registered, epsilon_x_percent, ... measured_width_mm.
+    void scoreMetrics(const method::PanelReading &r, const method::PanelScore &s, const std::string &suffix) {
+        metric("registered" + suffix, r.registered ? 1 : 0);
+        metric("epsilon_x" + suffix + "_percent", s.epsilon_x_percent, "%");
+        metric("epsilon_y" + suffix + "_percent", s.epsilon_y_percent, "%");
+        metric("epsilon_z" + suffix + "_percent", s.epsilon_z_percent, "%");
+        metric("eta_2d" + suffix + "_percent", s.eta_2d_percent, "%");
+        metric("eta_3d" + suffix + "_percent", s.eta_3d_percent, "%");
+        metric("measured_width" + suffix + "_mm", r.width_mm, "mm");
+    }
 
     void metric(const std::string &name, double value, const std::string &unit = "") {
         host_.metric(name, value, unit);
@@ -263,13 +275,7 @@ private:
         if (!r.registered)
             host_.warning("frame " + std::to_string(sequence_) + ": panel not registered (rejected configuration): " +
                           r.reason);
-        metric("registered", r.registered ? 1 : 0);
-        metric("epsilon_x_percent", s.epsilon_x_percent, "%");
-        metric("epsilon_y_percent", s.epsilon_y_percent, "%");
-        metric("epsilon_z_percent", s.epsilon_z_percent, "%");
-        metric("eta_2d_percent", s.eta_2d_percent, "%");
-        metric("eta_3d_percent", s.eta_3d_percent, "%");
-        metric("measured_width_mm", r.width_mm, "mm");
+        scoreMetrics(r, s, "");
         metric("measured_range_mm", r.range_mm, "mm");
         metric("measured_height_mm", r.height_mm, "mm");
         metric("true_width_mm", trueSize.width_mm, "mm");
@@ -365,13 +371,7 @@ private:
         const method::PanelScore s = method::scorePanel(r.size(), trueSize, r.registered);
         if (!r.registered)
             host_.warning("frame " + std::to_string(sequence_) + ": panel not registered on the ground-truth cloud (oracle): " + r.reason);
-        metric("registered_oracle", r.registered ? 1 : 0);
-        metric("epsilon_x_oracle_percent", s.epsilon_x_percent, "%");
-        metric("epsilon_y_oracle_percent", s.epsilon_y_percent, "%");
-        metric("epsilon_z_oracle_percent", s.epsilon_z_percent, "%");
-        metric("eta_2d_oracle_percent", s.eta_2d_percent, "%");
-        metric("eta_3d_oracle_percent", s.eta_3d_percent, "%");
-        metric("measured_width_oracle_mm", r.width_mm, "mm");
+        scoreMetrics(r, s, "_oracle");
         metric("eta_3d_matcher_loss_percent", s.eta_3d_percent - measured.eta_3d_percent, "%");
     }
 
@@ -408,7 +408,7 @@ private:
         drawings.top.push_back({{r.x_min_mm, r.x_max_mm}, r.band,
                                 "panel X' " + fixed(r.width_mm / 1000, 2) + " m, Y' " + fixed(r.range_mm / 1000, 2) + " m",
                                 red, r.top_cells, cell});
-        drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m", red});
+        drawings.side.push_back({r.band, {r.z_bottom_mm, r.z_top_mm}, "Y' " + fixed(r.range_mm / 1000, 2) + " m", red, {}, 0});
     }
 
     // Eq. 7 and the sensor-aware figures, when B, f and p are known.
