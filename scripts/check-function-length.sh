@@ -14,6 +14,9 @@
 #     member initialiser) is a function of its own, counted from its `[`.
 #   - Not functions: namespace, class, enum and extern "C" blocks and initialiser braces
 #     (a long table or a long class of short methods passes).
+#   - A signature starts at the first token after the previous `;`, `{`, `}` or access
+#     label (public:) of its scope: a macro call written there without a `;` counts
+#     with the function that follows it.
 #   - Comments, string and character literals (raw strings R"x(...)x" too) and
 #     preprocessor lines are read as such, never as code. Where the branches of an
 #     #if/#elif/#else do not each balance their braces and parentheses (two openings of one
