@@ -406,57 +406,82 @@ void VidereSource::stop() {
 
 std::unique_ptr<sdk::Frame> VidereSource::grab(int32_t timeout_ms) {
     if (!started_) throw Error(BINOCLE_ERR_INVALID_ARGUMENT, "videre1394: grab before start (or after stop)");
+    checkRingHasRoom();
+    const RawFrame f = nextWholeFrame(timeout_ms);
+    checkFrameGeometry(f);
+    return lend(f);
+}
+
+// The ring needs a buffer of its own to fill: a grab while the host holds all the others
+// would wait for ever.
+void VidereSource::checkRingHasRoom() const {
     Capture &c = *capture_;
+    std::lock_guard<std::mutex> lock(c.mutex);
+    if (!c.gone.empty()) throw Error(BINOCLE_ERR_DEVICE, c.gone);
+    if (c.lent + 1 >= settings_.bufferCount)
+        throw Error(BINOCLE_ERR_BUSY, "videre1394: " + std::to_string(c.lent) + " of the " +
+                                          std::to_string(settings_.bufferCount) + " DMA buffers of camera " + c.name +
+                                          " are lent to the host and the ring needs one to fill; release frames "
+                                          "before grabbing more, or raise buffer_count");
+}
+
+// Remembered, so that every later call says why the camera is gone.
+Error VidereSource::lostCamera(const DeviceError &e) {
+    Capture &c = *capture_;
+    std::lock_guard<std::mutex> lock(c.mutex);
+    c.gone = "videre1394: camera " + c.name + " stopped delivering after " + std::to_string(c.dequeued) +
+             " frames (" + e.what() + "): cable unplugged, power lost or bus reset";
+    return Error(BINOCLE_ERR_DEVICE, c.gone);
+}
+
+// Takes a filled buffer off the ring, if one is there; the camera's loss is thrown as
+// lostCamera() says it, any other device error as it is.
+bool VidereSource::dequeue(RawFrame &f) {
+    Capture &c = *capture_;
+    std::optional<DeviceError> lost;
     {
         std::lock_guard<std::mutex> lock(c.mutex);
-        if (!c.gone.empty()) throw Error(BINOCLE_ERR_DEVICE, c.gone);
-        if (c.lent + 1 >= settings_.bufferCount)
-            throw Error(BINOCLE_ERR_BUSY, "videre1394: " + std::to_string(c.lent) + " of the " +
-                                              std::to_string(settings_.bufferCount) + " DMA buffers of camera " + c.name +
-                                              " are lent to the host and the ring needs one to fill; release frames "
-                                              "before grabbing more, or raise buffer_count");
+        try {
+            return c.camera().dequeue(f);
+        } catch (const DeviceError &e) {
+            if (e.kind() != DeviceError::Kind::Gone)
+                throw Error(BINOCLE_ERR_DEVICE, "videre1394: camera " + c.name + ": " + e.what());
+            lost = e;
+        }
     }
+    throw lostCamera(*lost); // outside the lock: lostCamera takes it
+}
+
+// Counts a dequeued frame; a corrupt one goes straight back to the ring. Returns whether
+// the frame is whole.
+bool VidereSource::acceptDequeued(RawFrame &f) {
+    Capture &c = *capture_;
+    std::lock_guard<std::mutex> lock(c.mutex);
+    ++c.dequeued;
+    c.framesBehind = f.framesBehind;
+    c.framesBehindMax = std::max(c.framesBehindMax, f.framesBehind);
+    if (!f.corrupt) return true;
+    ++c.corrupt;
+    try {
+        c.camera().enqueue(f);
+    } catch (const DeviceError &) {
+    }
+    return false;
+}
+
+// The next frame the camera delivers whole, waiting up to timeout_ms (< 0: for ever).
+RawFrame VidereSource::nextWholeFrame(int32_t timeout_ms) {
     using Clock = std::chrono::steady_clock;
     const auto deadline = Clock::now() + std::chrono::milliseconds(std::max(timeout_ms, 0));
-    auto lostCamera = [&](const DeviceError &e) -> Error {
-        std::lock_guard<std::mutex> lock(c.mutex);
-        c.gone = "videre1394: camera " + c.name + " stopped delivering after " + std::to_string(c.dequeued) +
-                 " frames (" + e.what() + "): cable unplugged, power lost or bus reset";
-        return Error(BINOCLE_ERR_DEVICE, c.gone);
-    };
-
+    Capture &c = *capture_;
     RawFrame f;
     for (;;) {
-        bool got = false;
-        std::optional<DeviceError> lost;
-        {
-            std::lock_guard<std::mutex> lock(c.mutex);
-            try {
-                got = c.camera().dequeue(f);
-            } catch (const DeviceError &e) {
-                if (e.kind() != DeviceError::Kind::Gone)
-                    throw Error(BINOCLE_ERR_DEVICE, "videre1394: camera " + c.name + ": " + e.what());
-                lost = e;
-            }
-        }
-        if (lost) throw lostCamera(*lost);
-        if (got) {
-            std::lock_guard<std::mutex> lock(c.mutex);
-            ++c.dequeued;
-            c.framesBehind = f.framesBehind;
-            c.framesBehindMax = std::max(c.framesBehindMax, f.framesBehind);
-            if (f.corrupt) {
-                ++c.corrupt;
-                try {
-                    c.camera().enqueue(f);
-                } catch (const DeviceError &) {
-                }
-                if (timeout_ms >= 0 && Clock::now() > deadline)
-                    throw Error(BINOCLE_ERR_TIMEOUT, "videre1394: only corrupt frames from camera " + c.name + " within " +
-                                                         std::to_string(timeout_ms) + " ms");
-                continue;
-            }
-            break;
+        if (dequeue(f)) {
+            if (acceptDequeued(f)) return f;
+            if (timeout_ms >= 0 && Clock::now() > deadline)
+                throw Error(BINOCLE_ERR_TIMEOUT, "videre1394: only corrupt frames from camera " + c.name + " within " +
+                                                     std::to_string(timeout_ms) + " ms");
+            continue;
         }
         int remaining = -1;
         if (timeout_ms >= 0)
@@ -474,27 +499,36 @@ std::unique_ptr<sdk::Frame> VidereSource::grab(int32_t timeout_ms) {
                                                  std::to_string(timeout_ms) + " ms (" + mode_.name +
                                                  (mode_.format7 ? "" : " at " + number(settings_.fps) + " fps") + ")");
     }
+}
 
-    // A frame of another size or depth than the mode's cannot be split: give it back.
-    const uint64_t need = static_cast<uint64_t>(mode_.width) * mode_.height * 2;
-    if (f.width != mode_.width || f.height != mode_.height ||
-        !interleavedFrameProblem(f.width, f.height, f.stride, f.bitsPerPixel, f.imageBytes, settings_.decimation).empty()) {
+// A frame of another size or depth than the mode's cannot be split: give it back.
+void VidereSource::checkFrameGeometry(const RawFrame &f) {
+    if (f.width == mode_.width && f.height == mode_.height &&
+        interleavedFrameProblem(f.width, f.height, f.stride, f.bitsPerPixel, f.imageBytes, settings_.decimation).empty())
+        return;
+    Capture &c = *capture_;
+    {
         std::lock_guard<std::mutex> lock(c.mutex);
         try {
             c.camera().enqueue(f);
         } catch (const DeviceError &) {
         }
-        throw Error(BINOCLE_ERR_DEVICE, "videre1394: camera " + c.name + " delivered a " + std::to_string(f.width) + "x" +
-                                            std::to_string(f.height) + " frame of " + std::to_string(f.bitsPerPixel) +
-                                            "-bit pixels (" + std::to_string(f.imageBytes) + " bytes), expected " +
-                                            std::to_string(mode_.width) + "x" + std::to_string(mode_.height) +
-                                            " of 16-bit pixels (" + std::to_string(need) + " bytes) for " + mode_.name);
     }
+    const uint64_t need = static_cast<uint64_t>(mode_.width) * mode_.height * 2;
+    throw Error(BINOCLE_ERR_DEVICE, "videre1394: camera " + c.name + " delivered a " + std::to_string(f.width) + "x" +
+                                        std::to_string(f.height) + " frame of " + std::to_string(f.bitsPerPixel) +
+                                        "-bit pixels (" + std::to_string(f.imageBytes) + " bytes), expected " +
+                                        std::to_string(mode_.width) + "x" + std::to_string(mode_.height) +
+                                        " of 16-bit pixels (" + std::to_string(need) + " bytes) for " + mode_.name);
+}
 
+// Splits the frame in its own DMA buffer and lends that buffer to the host: it returns
+// to the ring when the host releases the frame.
+std::unique_ptr<sdk::Frame> VidereSource::lend(const RawFrame &f) {
     splitInterleaved(f.image, f.width, f.height, f.stride, settings_.decimation, settings_.leftIsFirstByte, scratch_);
     {
-        std::lock_guard<std::mutex> lock(c.mutex);
-        ++c.lent;
+        std::lock_guard<std::mutex> lock(capture_->mutex);
+        ++capture_->lent;
     }
     auto frame = std::make_unique<sdk::Frame>();
     const int32_t w = static_cast<int32_t>(outWidth_), h = static_cast<int32_t>(outHeight_);

@@ -69,6 +69,15 @@ private:
     void selectMode();
     void readCalibration();
 
+    // The steps of grab(), in order.
+    void checkRingHasRoom() const;
+    RawFrame nextWholeFrame(int32_t timeout_ms);
+    bool dequeue(RawFrame &f);
+    bool acceptDequeued(RawFrame &f);
+    sdk::Error lostCamera(const DeviceError &e);
+    void checkFrameGeometry(const RawFrame &f);
+    std::unique_ptr<sdk::Frame> lend(const RawFrame &f);
+
     sdk::Host host_;
     Settings settings_;
     std::shared_ptr<Capture> capture_;
