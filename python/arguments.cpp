@@ -65,6 +65,19 @@ std::optional<int64_t> wholeNumber(const py::handle &value, const std::string &n
     return static_cast<int64_t>(v);
 }
 
+double realNumber(const py::handle &value, const std::string &name) {
+    const bool number = PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()) || isNumpy(value, "number");
+    if (PyBool_Check(value.ptr()) || !number) refuse(name, value, "expected a number, not a " + typeName(value));
+    return value.cast<double>();
+}
+
+std::optional<std::string> text(const py::handle &value, const std::string &name, const std::string &none) {
+    const std::string expected = "expected a str" + (none.empty() ? "" : " or None (" + none + ")");
+    if (value.is_none() && !none.empty()) return std::nullopt;
+    if (!py::isinstance<py::str>(value)) refuse(name, value, expected + ", not a " + typeName(value));
+    return value.cast<std::string>();
+}
+
 bool flag(const py::handle &value, const std::string &name) {
     if (PyBool_Check(value.ptr())) return value.ptr() == Py_True;
     if (isNumpy(value, "bool_")) return value.attr("item")().ptr() == Py_True;

@@ -29,6 +29,12 @@ struct ArgumentError : Error {
 std::optional<int64_t> wholeNumber(const py::handle &value, const std::string &name, int64_t least,
                                    int64_t most = std::numeric_limits<int64_t>::max(), const std::string &none = {});
 
+// A real number: a Python int or float, or a numpy number; not a bool or a text.
+double realNumber(const py::handle &value, const std::string &name);
+
+// A str; `none`, when not empty, says what None means (then None returns nullopt).
+std::optional<std::string> text(const py::handle &value, const std::string &name, const std::string &none = {});
+
 // True or False (numpy.bool_ too); not 0, 1, None or a text.
 bool flag(const py::handle &value, const std::string &name);
 

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The `binocle` Python module (_binocle; binocle/__init__.py re-exports it): Rig and its
-// runs, experiment(), plugins(), the exceptions. The same framework code as the CLI.
+// runs, experiment(), design(), plugins(), the exceptions. The same framework code as the CLI.
 #include "python/arguments.hpp"
 #include "python/convert.hpp"
+#include "python/design_call.hpp"
 #include "python/experiment_call.hpp"
 #include "python/lifecycle.hpp"
 #include "python/run.hpp"
 
+#include "app/request.hpp"
 #include "config/rig_config.hpp"
 #include "core/log.hpp"
 #include "host/install_prefix.hpp"
@@ -76,6 +78,8 @@ void translate(std::exception_ptr p) {
         PyErr_SetString(g_usageError, e.what());
     } catch (const ArgumentError &e) {
         PyErr_SetString(g_usageError, e.what());
+    } catch (const app::RequestError &e) {
+        PyErr_SetString(g_usageError, e.what());
     } catch (const PluginError &e) {
         PyErr_SetString(g_pluginError, e.what());
     } catch (const Error &e) {
@@ -91,19 +95,8 @@ PyObject *newException(py::module_ &m, const char *name, const char *doc, py::tu
     return type;
 }
 
-} // namespace
-
-PYBIND11_MODULE(_binocle, m) {
-    m.doc() = "Binocle from Python: rigs run through the framework's stage pipeline, experiments and the plugin list.";
-    // The CLI's limit for the image formats whose header input/image_file.cpp does not read.
-    ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(input::kMaxImagePixels).c_str(), 0);
-    // Warnings and errors as the CLI words them ("binocle: warn: ..."), on stderr.
-    LogOptions log;
-    log.program = "binocle";
-    setupLogging(log);
-    // numpy's C API, the exit hook, the fork handler (docs/python.md, "Threads, fork and exit").
-    setUpLifecycle();
-
+// binocle.Error and its subclasses; C++ errors become them (translate).
+void defineExceptions(py::module_ &m) {
     g_error = newException(m, "Error", "An error of Binocle: a file, key, value, plugin or device, named with what was expected "
                                        "(the message of the `binocle` command for the same mistake).",
                            py::make_tuple(py::handle(PyExc_RuntimeError)));
@@ -112,14 +105,20 @@ PYBIND11_MODULE(_binocle, m) {
     g_pluginError = newException(m, "PluginError", "A plugin refused a call or misbehaved; the message names it.",
                                  py::make_tuple(py::handle(g_error)));
     py::register_exception_translator(&translate);
+}
 
+// Where the plugins lie, the versions.
+void defineInstall(py::module_ &m) {
     m.def("_set_install_prefix", &setInstallPrefix, py::arg("prefix"),
           "Where the plugins (lib/binocle/plugins) and the plugin helper (libexec/binocle) lie; set by binocle/__init__.py.");
     m.def("install_prefix", &installPrefix, "The prefix the plugins and the plugin helper are found under.");
     m.attr("__version__") = BINOCLE_VERSION;
     m.attr("ABI_VERSION") = BINOCLE_ABI_VERSION;
     m.attr("API_VERSION") = BINOCLE_API_VERSION;
+}
 
+// binocle.Frame and binocle.Run: a run's frames as they finish.
+void defineRun(py::module_ &m) {
     py::class_<Frame>(m, "Frame", "One finished frame of a run; the arrays are owned by the frame (valid as long as they are used).")
         .def_readonly("index", &Frame::index, "0, 1, 2 ... frames finished in this run")
         .def_readonly("sequence", &Frame::sequence, "the source's sequence number")
@@ -153,7 +152,10 @@ PYBIND11_MODULE(_binocle, m) {
         .def("__exit__", [](Run &r, const py::object &, const py::object &, const py::object &) { r.close(); })
         .def_property_readonly("summary", &Run::summary,
                                "The run's summary (as summary.json: status, frame_count, metrics ...) once it ended; None before.");
+}
 
+// binocle.Rig: a rig file loaded and checked, and its runs.
+void defineRig(py::module_ &m) {
     py::class_<Rig>(m, "Rig",
                     "A rig file, loaded and checked as `binocle run RIG --set KEY=VALUE` does.\n\n"
                     "set: {'matcher.num_disparities': 128} or ['matcher.num_disparities=128']; values other than\n"
@@ -172,7 +174,10 @@ PYBIND11_MODULE(_binocle, m) {
         .def_property_readonly("source", [](const Rig &r) { return r.config().source().plugin; }, "the source plugin's name")
         .def_property_readonly("matcher", [](const Rig &r) { return r.config().matcher().plugin; }, "the matcher plugin's name")
         .def("__repr__", [](const Rig &r) { return "<binocle.Rig '" + r.config().name + "' " + r.config().file + ">"; });
+}
 
+// binocle.experiment(), design(), plugins() and the search path.
+void defineFunctions(py::module_ &m) {
     m.def("experiment", &binocle::python::experiment, py::arg("file"), py::arg("set") = py::none(), py::arg("out") = py::none(),
           py::arg("tests") = py::tuple(), py::arg("force") = false, py::arg("progress") = false,
           "Runs an experiment file as `binocle experiment FILE --set KEY=VALUE --out DIR --tests ...` does and\n"
@@ -201,4 +206,25 @@ PYBIND11_MODULE(_binocle, m) {
         "The files `binocle plugins` lists as refused: [{'path', 'reason'}].");
     m.def("plugin_search_path", &PluginHost::defaultSearchPath,
           "The folders searched for plugins: $BINOCLE_PLUGIN_PATH, then <prefix>/lib/binocle/plugins.");
+    defineDesign(m);
+}
+
+} // namespace
+
+PYBIND11_MODULE(_binocle, m) {
+    m.doc() = "Binocle from Python: rigs run through the framework's stage pipeline, experiments, designs and the plugin list.";
+    // The CLI's limit for the image formats whose header input/image_file.cpp does not read.
+    ::setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(input::kMaxImagePixels).c_str(), 0);
+    // Warnings and errors as the CLI words them ("binocle: warn: ..."), on stderr.
+    LogOptions log;
+    log.program = "binocle";
+    setupLogging(log);
+    // numpy's C API, the exit hook, the fork handler (docs/python.md, "Threads, fork and exit").
+    setUpLifecycle();
+
+    defineExceptions(m);
+    defineInstall(m);
+    defineRun(m);
+    defineRig(m);
+    defineFunctions(m);
 }

@@ -7,9 +7,8 @@
 #include "python/convert.hpp"
 #include "python/lifecycle.hpp"
 
+#include "app/experiment_run.hpp"
 #include "core/atomic_file.hpp"
-#include "core/output_folder.hpp"
-#include "experiment/experiment.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -32,7 +31,7 @@ namespace {
 class ExperimentWork final : public Ending {
 public:
     std::atomic<bool> stop{false};
-    std::optional<OutputFolder> folder; // claimed before the tests start
+    std::optional<app::ExperimentRun> run; // its folder claimed before the tests start
     // Starts the tests; false (nothing started) once the interpreter exits.
     bool start(std::function<void()> tests) {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -49,11 +48,11 @@ public:
         std::unique_lock<std::mutex> lock(mutex_);
         return ended_.wait_for(lock, wait, [&] { return done_; });
     }
-    // Waits for the tests' thread, then lets go of the output folder (its lock).
+    // Waits for the tests' thread, then lets go of the output folder (its lock) and the plugins.
     void join() {
         std::lock_guard<std::mutex> lock(joining_);
         if (worker_.joinable()) worker_.join();
-        folder.reset();
+        if (run) run->release();
     }
     // The test in progress ends, no other starts; the tables say "interrupted".
     void endAtExit() override {
@@ -76,24 +75,19 @@ private:
 
 py::dict experiment(const py::object &file, const py::object &set, const py::object &out, const py::object &tests,
                     const py::object &force, const py::object &progress) {
-    const std::string path = *pathText(file, "file");
-    const std::vector<std::string> overrides = setTexts(set);
-    const std::optional<std::string> outText = pathText(out, "out", "out/<the experiment's name>");
-    ExperimentOptions options;
-    options.only = textList(tests, "tests");
-    options.replace = flag(force, "force");
-    options.progress = flag(progress, "progress");
+    app::ExperimentRequest request;
+    request.caller.command = "binocle.experiment";
+    request.file = *pathText(file, "file");
+    request.set = setTexts(set);
+    request.out = pathText(out, "out", "out/<the experiment's name>").value_or("");
+    request.tests = textList(tests, "tests");
+    request.force = flag(force, "force");
+    request.progress = flag(progress, "progress");
     auto work = std::make_shared<ExperimentWork>();
     keepUntilExit(work);
-    options.stop = &work->stop;
-    auto host = std::make_unique<PluginHost>();
-    std::optional<Experiment> e;
-    withoutGil([&] {
-        // Everything is checked before the first test runs (as `binocle experiment`).
-        e.emplace(loadExperiment(path, *host, overrides));
-        options.out_dir = outText ? *outText : "out/" + e->name;
-        work->folder.emplace(options.out_dir, OutputClaim{OutputKind::Experiment, options.replace, "binocle.experiment"});
-    });
+    request.stop = &work->stop;
+    // Everything is checked before the first test runs (as `binocle experiment`).
+    withoutGil([&] { work->run.emplace(request); });
     // The tests run on a thread of their own, so that this one sees Ctrl-C: no further
     // test starts, the tables say "interrupted", then the KeyboardInterrupt goes on. Nothing
     // below throws before the join (a thread abandoned at exit waits for ever meanwhile;
@@ -102,7 +96,7 @@ py::dict experiment(const py::object &file, const py::object &set, const py::obj
     std::exception_ptr error;
     const bool started = work->start([&] {
         try {
-            result = runExperiment(*e, *host, options);
+            result = work->run->run();
         } catch (...) {
             error = std::current_exception();
         }
@@ -115,16 +109,13 @@ py::dict experiment(const py::object &file, const py::object &set, const py::obj
             work->stop = true;
         }
     }
-    withoutGil([&] {
-        work->join();
-        host.reset();
-    });
+    withoutGil([&] { work->join(); });
     if (interrupt) throw *interrupt;
     if (error) std::rethrow_exception(error);
     // What the command wrote, as data: results.json (rows under "tests", with their
     // per-repeat details), plus where it lies and the run's own counts.
-    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(readTextFile((fs::path(options.out_dir) / "results.json").string()));
-    doc["out"] = options.out_dir;
+    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(readTextFile((fs::path(work->run->out()) / "results.json").string()));
+    doc["out"] = work->run->out();
     doc["failed"] = result.failed;
     doc["seconds"] = result.seconds;
     return toPython(doc).cast<py::dict>();

@@ -16,9 +16,14 @@ RunStream::RunStream(std::shared_ptr<const LoadedRig> rig, const StreamOptions &
     if (options_.depth < 1) options_.depth = 1;
     // Made here, on the caller's thread: a plugin that refuses its settings, or an output
     // folder that is taken, is an error of the call that asked for the run.
-    pipeline_ = std::make_unique<Pipeline>(rig_->rig, *rig_->host);
-    if (!options_.out_dir.empty())
-        folder_.emplace(options_.out_dir, OutputClaim{OutputKind::Run, options_.force, "binocle.Rig.run"});
+    app::RunRequest request;
+    request.caller.command = "binocle.Rig.run";
+    request.frames = options_.max_frames;
+    request.out = options_.out_dir;
+    request.force = options_.force;
+    request.progress = options_.progress;
+    request.stop = &stop_;
+    run_ = std::make_unique<app::RigRun>(rig_->rig, *rig_->host, request);
     thread_ = std::thread([this] { work(); });
 }
 
@@ -33,15 +38,10 @@ RunStream::~RunStream() {
 }
 
 void RunStream::work() {
-    RunOptions options;
-    options.max_frames = options_.max_frames;
-    options.out_dir = options_.out_dir;
-    options.progress = options_.progress;
-    options.stop = &stop_;
     nlohmann::ordered_json summary;
     std::exception_ptr error;
     try {
-        summary = pipeline_->run(options, [this](const FrameResult &r) { onFrame(r); });
+        summary = run_->run([this](const FrameResult &r) { onFrame(r); }).summary;
     } catch (...) {
         error = std::current_exception();
         // A failed run throws after writing its summary: with an output folder, that is
@@ -117,7 +117,7 @@ void RunStream::finish() {
         if (!joined_) {
             if (thread_.joinable()) thread_.join();
             joined_ = true;
-            folder_.reset(); // the lock of the output folder goes once the summary is written
+            run_->release(); // the lock of the output folder goes once the summary is written
         }
     }
     std::exception_ptr error;

@@ -3,8 +3,8 @@
 // of its images and cloud) to one consumer through a bounded queue; no Python here.
 #pragma once
 
+#include "app/run_rig.hpp"
 #include "config/rig_config.hpp"
-#include "core/output_folder.hpp"
 #include "host/plugin_host.hpp"
 #include "pipeline/pipeline.hpp"
 
@@ -76,8 +76,7 @@ private:
 
     std::shared_ptr<const LoadedRig> rig_;
     StreamOptions options_;
-    std::unique_ptr<Pipeline> pipeline_;
-    std::optional<OutputFolder> folder_;
+    std::unique_ptr<app::RigRun> run_; // the pipeline and the output folder
     std::atomic<bool> stop_{false};
     mutable std::mutex mutex_;
     std::condition_variable changed_;

@@ -154,12 +154,4 @@ CLI::Validator wholeNumbers(char separator, long long min) {
         "");
 }
 
-std::string dataFile(const std::string &relative) {
-    std::error_code ec;
-    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const auto installed = exe.parent_path().parent_path() / BINOCLE_DATA_INSTALL_DIR / relative;
-    if (!ec && std::filesystem::exists(installed)) return installed.string();
-    return (std::filesystem::path(BINOCLE_SOURCE_DIR) / relative).string();
-}
-
 } // namespace binocle::cli

@@ -1,70 +1,51 @@
 // SPDX-License-Identifier: MIT
 // `binocle experiment FILE`: runs the tests of an experiment (METHOD.md E1, E2).
+#include "app/experiment_run.hpp"
 #include "cli/command.hpp"
 #include "core/error.hpp"
-#include "core/output_folder.hpp"
-#include "experiment/experiment.hpp"
 #include "report/html_report.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <iostream>
-#include <tuple>
 
 namespace binocle::cli {
 namespace {
 
 struct ExperimentArgs {
-    std::string file, out, shard;
-    std::vector<std::string> tests, set;
-    bool check = false, quiet = false, report = false, force = false;
+    app::ExperimentRequest request; // file, set, tests, shard, out, force
+    bool check = false, quiet = false, report = false;
     std::vector<std::string> merge; // `experiment merge OUT DIR...`
 };
 
 int merge(const std::vector<std::string> &p, bool force) {
     if (p.size() < 2) throw Error("expected: binocle experiment merge OUT DIR... (the output folders of the shards)");
-    PluginHost host;
-    host.scan();
-    const OutputFolder folder(p[0], OutputClaim{OutputKind::Experiment, force, "binocle experiment merge"});
-    const ExperimentResult result = mergeExperimentResults(p[0], std::vector<std::string>(p.begin() + 1, p.end()), host, force);
+    app::MergeRequest request;
+    request.out = p[0];
+    request.folders.assign(p.begin() + 1, p.end());
+    request.force = force;
+    const ExperimentResult result = app::mergeExperiment(request);
     spdlog::info("experiment: {} test(s) merged from {} folder(s), {} failed; results in {}", result.rows.size(), p.size() - 1,
                  result.failed, p[0]);
     return result.failed ? 1 : 0;
 }
 
-int experiment(const ExperimentArgs &args) {
-    if (!args.merge.empty()) return merge(args.merge, args.force);
-    if (args.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
-    PluginHost host;
-    // No scan: the rig opens only the plugins it names.
-    // Everything is checked before the first test runs.
-    Experiment e;
-    try {
-        e = loadExperiment(args.file, host, args.set);
-    } catch (const OverrideError &x) {
-        throw UsageError(x.what()); // a bad --set is a bad value on the command line: exit 2
-    }
+int experiment(ExperimentArgs args) {
+    if (!args.merge.empty()) return merge(args.merge, args.request.force);
+    if (args.request.file.empty()) throw Error("expected an experiment file: binocle experiment FILE (see --help)");
+    args.request.progress = !args.quiet;
     if (args.check) {
+        PluginHost host;
+        // Everything is checked, nothing runs.
+        const Experiment e = app::loadExperiment(args.request, host);
         std::cout << "experiment " << e.name << ": " << e.tests.size() << " tests, rig " << e.rig_file << ": valid\n";
         return 0;
     }
-    ExperimentOptions options;
-    options.out_dir = args.out.empty() ? "out/" + e.name : args.out;
-    options.progress = !args.quiet;
-    options.replace = args.force;
-    for (const auto &id : args.tests)
-        if (!id.empty()) options.only.push_back(id);
-    try { // --shard and --tests are values of the command line: a mistake there is exit 2
-        if (!args.shard.empty()) std::tie(options.shard_index, options.shard_count) = parseShard(args.shard);
-        selectTests(e, options);
-    } catch (const Error &x) {
-        throw UsageError(x.what());
-    }
-    const OutputFolder folder(options.out_dir, OutputClaim{OutputKind::Experiment, args.force, "binocle experiment"});
-    const ExperimentResult result = runExperiment(e, host, options);
+    app::ExperimentRun run(args.request);
+    const ExperimentResult result = run.run();
     spdlog::info("experiment {}: {} test(s) in {} s, {} failed; results in {} (results.csv, results.json, charts, test_<id>/)",
-                 e.name, result.rows.size(), static_cast<int>(result.seconds), result.failed, options.out_dir);
-    if (args.report) spdlog::info("report: {}", report::writeExperimentReport(options.out_dir));
+                 run.experiment().name, result.rows.size(), static_cast<int>(result.seconds), result.failed, run.out());
+    if (args.report) spdlog::info("report: {}", report::writeExperimentReport(run.out()));
     return result.failed ? 1 : 0;
 }
 
@@ -89,13 +70,13 @@ Register experimentCommand{{"experiment", "run an experiment (E1, E2 of METHOD.m
               "--set dataset=DIR --set 'matcher={plugin: NAME, ...}' measures any matcher.",
               define<ExperimentArgs>(
                   [](CLI::App &app, ExperimentArgs &args) {
-                      app.add_option("file", args.file, "the experiment file (YAML)")->type_name("FILE");
-                      app.add_option("--set", args.set,
+                      app.add_option("file", args.request.file, "the experiment file (YAML)")->type_name("FILE");
+                      app.add_option("--set", args.request.set,
                                      "change a key of the experiment file (repeats=10, calibration=board, "
                                      "board_calibration.pairs=15, seed=7, rig_set.source.image_width=640, dataset=DIR, matcher=sgm); repeatable")
                           ->type_name("KEY=VALUE")
                           ->allow_extra_args(false);
-                      app.add_option("--shard", args.shard,
+                      app.add_option("--shard", args.request.shard,
                                      "run the K-th of N deterministic shares of the tests (position % N == K-1); join the "
                                      "shards with `binocle experiment merge OUT DIR...`")
                           ->type_name("K/N")
@@ -103,14 +84,14 @@ Register experimentCommand{{"experiment", "run an experiment (E1, E2 of METHOD.m
                       auto *m = app.add_subcommand("merge", "join the output folders of shards into OUT: the same rows as "
                                                             "one unsharded run (timings apart)");
                       m->add_option("folders", args.merge, "OUT DIR...")->required()->expected(2, -1);
-                      app.add_option("--out", args.out, "output folder (default out/<experiment name>)")->type_name("DIR");
-                      app.add_option("--tests", args.tests, "run only these tests, e.g. --tests 1,5,9")
+                      app.add_option("--out", args.request.out, "output folder (default out/<experiment name>)")->type_name("DIR");
+                      app.add_option("--tests", args.request.tests, "run only these tests, e.g. --tests 1,5,9")
                           ->type_name("ID,ID...")
                           ->delimiter(',')
                           ->allow_extra_args(false);
                       app.add_flag("--check", args.check, "validate the file and stop");
-                      app.add_flag("--force", args.force, "replace the results of another experiment in the output folder");
-                      m->add_flag("--force", args.force, "replace the results already in OUT");
+                      app.add_flag("--force", args.request.force, "replace the results of another experiment in the output folder");
+                      m->add_flag("--force", args.request.force, "replace the results already in OUT");
                       app.add_flag("--quiet", args.quiet, "no progress display");
                       app.add_flag("--report", args.report, "also write DIR/report.html (as `binocle report DIR`)");
                   },

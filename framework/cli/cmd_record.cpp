@@ -1,12 +1,9 @@
 // SPDX-License-Identifier: MIT
 // `binocle record RIG.yaml --out DIR`: records a rig's source to a folder that the replay
 // plugin plays back (layout `recording`, plugins/replay/README.md).
+#include "app/record.hpp"
 #include "cli/command.hpp"
 #include "config/rig_config.hpp"
-#include "core/output_folder.hpp"
-#include "pipeline/recorder.hpp"
-#include "pipeline/stop_signal.hpp"
-#include "rosbag/rosbag_recording.hpp"
 
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
@@ -18,39 +15,20 @@ namespace {
 
 struct RecordArgs {
     RigArgs rig;
-    std::string out;
-    int64_t frames = -1;
-    int32_t timeout_ms = 5000;
-    int png_compression = 1;
-    int writer_threads = 0; // 0: the writer's default
-    std::string when_behind; // empty: from the source (drop when live)
+    app::RecordRequest request; // out, frames, timeout, PNG level, writers, format and its rosbag options
+    std::string when_behind;    // empty: from the source (drop when live)
     bool statistics = false, quiet = false;
-    std::string format = "folder";
-    RosbagOptions rosbag;
 };
 
-int record(const RecordArgs &args) {
-    if (args.out.empty()) throw UsageError("--out: expected the folder to record into");
+int record(RecordArgs args) {
     PluginHost host;
     // No scan: the rig opens only the plugins it names.
-    RigConfig rig = loadRig(args.rig, host);
-    RecordOptions options = framesAndProgress<RecordOptions>(args.frames, args.quiet);
-    options.grab_timeout_ms = args.timeout_ms;
-    // First Ctrl-C (or SIGTERM, SIGHUP): finish the frames being written and stop.
-    // Second: die at once (what is written stays readable either way).
-    StopSignalGuard signals;
-    options.stop = &StopSignalGuard::requested();
-    options.writer.png_compression = args.png_compression;
-    options.writer.threads = args.writer_threads;
-    if (!args.when_behind.empty()) options.drop_when_behind = args.when_behind == "drop";
-    checkRosbagOptions(args.rosbag);
-    // Where the pairs go: the folder of PNG pairs, or a rosbag2 bag; the recorder names neither.
-    options.sink = args.format == "mcap" ? rosbagRecordingSink(args.rosbag) : folderRecordingSink();
-    // One recorder per folder, marked as a recording; the writer itself refuses a folder
-    // that holds anything (a recording is never written over, --force or not).
-    OutputFolder folder(args.out, OutputClaim{OutputKind::Recording, false, "binocle record"});
-    RecordResult r = recordRig(rig, args.out, options);
-    spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, args.out, r.seconds);
+    const RigConfig rig = loadRig(args.rig, host);
+    args.request.progress = !args.quiet;
+    if (!args.when_behind.empty()) args.request.drop_when_behind = args.when_behind == "drop";
+    const RecordResult r = app::record(rig, args.request);
+    const std::string &out = args.request.out;
+    spdlog::info("binocle record: {} frame(s) of rig '{}' recorded to {} in {} s", r.frames, rig.name, out, r.seconds);
     // Where every pair that was not written went (also in DIR/summary.json).
     const nlohmann::ordered_json lost = recordingSummary(r)["lost"];
     std::string where = "binocle record: " + std::to_string(r.grabbed) + " pair(s) taken from the source, " +
@@ -92,20 +70,20 @@ Register recordCommand{{"record", "record a rig's source (any plugin) to a folde
               "Example: binocle record RIG.yaml --out recordings/run1 --frames 100 --set source.exposure_us=2000",
               defineOnRig<RecordArgs>(
                   [](CLI::App &app, RecordArgs &args) {
-                      app.add_option("--out", args.out,
+                      app.add_option("--out", args.request.out,
                                      "the recording folder; it must not exist or be empty (an existing recording is never overwritten)")
                           ->type_name("DIR")
                           ->required();
-                      addFramesOption(app, args.frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)");
-                      app.add_option("--timeout-ms", args.timeout_ms, "longest wait for one frame (default 5000)")
+                      addFramesOption(app, args.request.frames, "stop after N pairs from the source (default: until it ends or Ctrl-C)");
+                      app.add_option("--timeout-ms", args.request.timeout_ms, "longest wait for one frame (default 5000)")
                           ->type_name("MS")
                           ->check(atLeast(1));
-                      app.add_option("--png-compression", args.png_compression,
+                      app.add_option("--png-compression", args.request.png_compression,
                                      "zlib level 0..9 of the PNG images (default 1: fast, lossless)")
                           ->type_name("L")
                           ->check(wholeNumber())
                           ->check(CLI::Range(0, 9));
-                      app.add_option("--writer-threads", args.writer_threads,
+                      app.add_option("--writer-threads", args.request.writer_threads,
                                      "threads that encode and write images (default: two per core, 4..16)")
                           ->type_name("N")
                           ->check(atLeast(1));
@@ -114,18 +92,18 @@ Register recordCommand{{"record", "record a rig's source (any plugin) to a folde
                                      "(default: drop for a live source such as cameras, wait for files and simulations)")
                           ->type_name("wait|drop")
                           ->check(CLI::IsMember({"wait", "drop"}));
-                      app.add_option("--format", args.format,
+                      app.add_option("--format", args.request.format,
                                      "folder (PNG + frames.csv, the default) or mcap (a rosbag2 bag: docs/ros2.md)")
                           ->type_name("folder|mcap")
                           ->check(CLI::IsMember({"folder", "mcap"}));
-                      app.add_option("--ros-namespace", args.rosbag.ros_namespace,
+                      app.add_option("--ros-namespace", args.request.rosbag.ros_namespace,
                                      "mcap: the topics' namespace (default /binocle: /binocle/left/image_raw ...)")
                           ->type_name("NS")
                           ->check(CLI::Validator(rosNamespaceRefusal, "NS"));
-                      app.add_option("--frame-id-left", args.rosbag.frame_id_left,
+                      app.add_option("--frame-id-left", args.request.rosbag.frame_id_left,
                                      "mcap: header.frame_id of the left images (default binocle_left_optical)")
                           ->type_name("ID");
-                      app.add_option("--frame-id-right", args.rosbag.frame_id_right,
+                      app.add_option("--frame-id-right", args.request.rosbag.frame_id_right,
                                      "mcap: header.frame_id of the right images (default binocle_right_optical)")
                           ->type_name("ID");
                       app.add_flag("--statistics", args.statistics, "print the source's statistics (YAML) at the end");

@@ -3,6 +3,7 @@
 // its options defined on a CLI11 app and the function that runs once they are parsed.
 #pragma once
 
+#include "app/request.hpp"
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 
@@ -21,11 +22,9 @@ namespace binocle::cli {
 enum ExitStatus { kExitOk = 0, kExitFailed = 1, kExitUsage = 2 };
 
 // A mistake on the command line that CLI11 cannot see (options that exclude each other,
-// a malformed list): the command stops with exit status 2, like a parse error.
-class UsageError : public Error {
-public:
-    using Error::Error;
-};
+// a malformed list): the command stops with exit status 2, like a parse error. The
+// application layer's refusal of a bad request is the same error.
+using UsageError = app::RequestError;
 
 // What runs once the command line is parsed; returns the exit status. Exceptions:
 // UsageError -> 2, any other -> 1, with the message logged as an error.
@@ -91,15 +90,6 @@ std::function<Runner(CLI::App &app)> defineOnRig(Options options, Run run) {
 
 // --frames N: stop after N frames, a whole number >= 1 (`help` says of what and the default).
 CLI::Option *addFramesOption(CLI::App &app, int64_t &frames, const std::string &help);
-// The pipeline's options (RunOptions, RecordOptions) with --frames and --quiet applied:
-// at most `frames` frames (< 0: until the source ends), a progress display unless quiet.
-template <class Options> Options framesAndProgress(int64_t frames, bool quiet) {
-    Options options;
-    options.max_frames = frames;
-    options.progress = !quiet;
-    return options;
-}
-
 // Validators with messages in the words of the other errors. Every numeric option takes
 // one of these, before any other check: they read the text with the one number reader
 // (input/numbers.hpp: decimal only), so that `--frames 010` is an error, as in a rig
@@ -119,9 +109,5 @@ CLI::Option *addNumber(CLI::App &app, const std::string &name, T &value, const s
                        const std::string &type, const CLI::Validator &number) {
     return app.add_option(name, value, help)->type_name(type)->check(number);
 }
-
-// A file shipped with Binocle (e.g. "configs/rigs/sim-e1.yaml"): from the install prefix
-// next to the executable, else from the source tree it was built from.
-std::string dataFile(const std::string &relative);
 
 } // namespace binocle::cli

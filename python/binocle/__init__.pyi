@@ -92,6 +92,18 @@ def experiment(file: PathArg, set: SetArg = None, out: Optional[PathArg] = None,
     """Runs an experiment file as `binocle experiment`; returns its results.json (rows under 'tests')
     plus 'out', 'failed' and 'seconds'."""
 
+Numbers = Union[str, float, Sequence[float], None]
+
+def design(*, range: Numbers = None, band: Numbers = None, lenses: Numbers = None, baselines: Numbers = None,
+           pixel_pitch_um: Optional[float] = None, image_width: Optional[int] = None, image_height: Optional[int] = None,
+           num_disparities: Optional[int] = None, camera_height_mm: Optional[float] = None,
+           inclination_deg: Optional[float] = None, panel_width_mm: Optional[float] = None,
+           panel_height_mm: Optional[float] = None, predictors_from: Optional[PathArg] = None,
+           predictor: Optional[str] = None, simulate: bool = False, simulate_count: int = 12,
+           rig: Optional[PathArg] = None, out: Optional[PathArg] = None, force: bool = False,
+           progress: bool = False) -> List[Dict[str, Any]]:
+    """Ranks baselines and lenses as `binocle design` does; returns design.json's candidates, best first."""
+
 def plugins(load: Sequence[str] = (), timeout_ms: int = 5000) -> List[Dict[str, Any]]:
     """The plugins `binocle plugins` lists, with their settings."""
 
