@@ -7,7 +7,7 @@
 #include "python/convert.hpp"
 #include "python/lifecycle.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/output_folder.hpp"
 #include "experiment/experiment.hpp"
 

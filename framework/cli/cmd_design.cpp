@@ -4,7 +4,7 @@
 // sensor-aware figures; with --simulate, by the stereo efficiency η3D measured on the
 // simulated rig.
 #include "cli/command.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/json.hpp"
 #include "core/output_folder.hpp"

@@ -2,7 +2,7 @@
 // Stereo calibration file: read, write, rectify.
 #include "core/calibration.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 
 #include "input/image_file.hpp"

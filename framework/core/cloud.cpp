@@ -2,7 +2,7 @@
 // Point clouds: triangulation from disparity and binary PLY.
 #include "core/cloud.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
 #include "input/numbers.hpp"

@@ -5,7 +5,7 @@
 #include "experiment/test_rig.hpp"
 
 #include "config/rig_config.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "input/numbers.hpp"
 #include "input/text.hpp"

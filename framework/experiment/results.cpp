@@ -2,7 +2,7 @@
 // results.csv and results.json of an experiment, and the rows they hold.
 #include "experiment/results.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "experiment/test_rig.hpp"
 #include "host/plugin_host.hpp"
 #include "host/plugin_kinds.hpp"

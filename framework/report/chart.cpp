@@ -2,7 +2,7 @@
 // Charts: one layout, drawn on two canvases (SVG text and an OpenCV image).
 #include "report/chart.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/image_io.hpp"
 #include "input/text.hpp"
 

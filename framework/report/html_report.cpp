@@ -2,7 +2,7 @@
 // The HTML report of an experiment, built from its output folder.
 #include "report/html_report.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "input/text.hpp"
 #include "report/chart.hpp"

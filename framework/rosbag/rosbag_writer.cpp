@@ -2,7 +2,7 @@
 // RosbagWriter: Binocle's images, disparities, clouds and figures as a rosbag2 MCAP bag.
 #include "rosbag/rosbag_writer.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "input/text.hpp"
