@@ -4,16 +4,17 @@
 // sensor-aware figures; with --simulate, by the stereo efficiency η3D measured on the
 // simulated rig.
 #include "cli/command.hpp"
-#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/json.hpp"
 #include "core/output_folder.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/predictor_choice.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -61,15 +62,15 @@ std::string exampleOf(const std::string &option) {
 // Numbers separated by commas, at least one: "" and "6000," are refused, not read as fewer.
 std::vector<double> numberList(const std::string &option, const std::string &text, char separator = ',') {
     std::vector<double> out;
-    const std::string shown = option + " " + input::printable(text);
+    const std::string shown = option + " " + sdk::printable(text);
     if (text.empty()) throw UsageError(shown + ": expected at least one number (e.g. " + exampleOf(option) + ")");
     for (size_t start = 0;;) {
         const size_t end = text.find(separator, start);
         const std::string item = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
         double v = 0;
         std::string why;
-        if (!input::parseReal(item, v, &why)) // decimal and finite: no "nan", "inf" or "0x1p3"
-            throw UsageError(shown + ": '" + input::printable(item) + "' is not valid: " + why + " (e.g. " + exampleOf(option) + ")");
+        if (!sdk::parseDecimalReal(item, v, &why)) // decimal and finite: no "nan", "inf" or "0x1p3"
+            throw UsageError(shown + ": '" + sdk::printable(item) + "' is not valid: " + why + " (e.g. " + exampleOf(option) + ")");
         out.push_back(v);
         if (end == std::string::npos) return out;
         start = end + 1;

@@ -2,11 +2,11 @@
 // results.csv and results.json of an experiment, and the rows they hold.
 #include "experiment/results.hpp"
 
-#include "files/atomic_file.hpp"
 #include "experiment/test_rig.hpp"
+#include "files/atomic_file.hpp"
 #include "host/plugin_host.hpp"
 #include "host/plugin_kinds.hpp"
-#include "input/text.hpp"
+#include "input/names.hpp"
 #include "method/statistics.hpp"
 
 #include <algorithm>

@@ -5,8 +5,10 @@
 
 #include "random.hpp"
 
-#include "input/numbers.hpp"
+#include "input/integer_range.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
 
 #include <yaml-cpp/yaml.h>
 
@@ -139,7 +141,7 @@ public:
 private:
     double scalar(const YAML::Node &n, const std::string &what) const {
         double v = 0;
-        if (!n.IsScalar() || !binocle::input::parseReal(n.Scalar(), v))
+        if (!n.IsScalar() || !binocle::sdk::parseDecimalReal(n.Scalar(), v))
             fail(n, what + " = '" + text(n) + "': expected a finite decimal number");
         return v;
     }
