@@ -100,7 +100,7 @@ OJson predictorRho(const std::vector<Row> &rows) {
     out["best"] = best.empty() ? OJson() : OJson(best);
     out["note"] = "each predictor as a score where higher should mean better: ff_band = -(log distance of FF from "
                   "1.2-2.0), depth_resolution = -dR/R, sensor_aware = eta_3d predicted from the design "
-                  "(framework/method/predictors.hpp)";
+                  "(base/method/predictors.hpp)";
     return out;
 }
 

@@ -65,7 +65,7 @@ public:
     int integer(const YAML::Node &map, const std::string &key, int def, int min, const std::string &what) const {
         const YAML::Node n = map[key];
         if (!n) return def;
-        // The one strict reader (framework/input): decimal, within int, no octal "0640".
+        // The one strict reader (the SDK's, with base/input's range check): decimal, within int, no octal "0640".
         int64_t parsed = 0;
         if (!n.IsScalar() || !binocle::input::parseInteger(n.Scalar(), parsed, nullptr, INT32_MIN, INT32_MAX))
             fail(n, what + "." + key + " = '" + text(n) + "': expected a decimal integer");
