@@ -8,7 +8,7 @@
 #include "python/lifecycle.hpp"
 
 #include "app/experiment_run.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 
 #include <atomic>
 #include <chrono>

@@ -2,7 +2,7 @@
 // The run's thread and the bounded queue between the pipeline's writer stage and Python.
 #include "python/run_stream.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 
 #include <filesystem>
 #include <spdlog/spdlog.h>

@@ -2,18 +2,26 @@
 # SPDX-License-Identifier: MIT
 # The layers of docs/DEVELOPING.md ("Layers"), checked from the #include lines: fails
 # (exit 1), naming each file and line, on
-#   - an include from sdk/ into framework/ or plugins/ (the SDK stands alone);
-#   - an include from a plugin into framework/ other than the layers a plugin may use
-#     (framework/input, framework/method: ALLOWED_PLUGIN_MODULES below);
+#   - an include from sdk/ into base/, framework/ or plugins/ (the SDK stands alone);
+#   - an include from base/ into framework/ or plugins/ (the base layer uses the SDK and
+#     itself only);
+#   - an include from a plugin into framework/, or into another plugin's folder other
+#     than plugins/common/ (a plugin uses the SDK, base/ and plugins/common/ only);
 #   - an include from framework/pipeline/ into framework/rosbag/ (rosbag builds on the
 #     pipeline's interfaces, never the reverse);
-#   - any cycle between framework modules (framework/<module>/): the module graph is
-#     made from the includes, and each cycle is reported with the includes that make it.
+#   - an include of framework/app/ from any framework module but cli/ (the application
+#     layer is on top: the CLI and the Python module call it, nothing below does);
+#   - a module name used by both base/ and framework/ ("<module>/x.hpp" would find one
+#     of them by the search order alone);
+#   - any cycle between modules (base/<module>/ and framework/<module>/ together): the
+#     module graph is made from the includes, and each cycle is reported with the
+#     includes that make it.
 # An include is resolved as the compiler would find it: beside the including file, then
-# under sdk/include, framework/ and plugins/; one that resolves to no file of the tree
-# (the standard library, OpenCV ...) is not looked at.
+# under sdk/include, base/, framework/ and plugins/; one that resolves to no file of the
+# tree (the standard library, OpenCV ...) is not looked at.
 # Usage: scripts/check-layers.sh [SOURCE_DIR]  (default: the tree holding this script).
-# Run by CTest as `check_layers` (tests/layers/CMakeLists.txt).
+# Run by CTest as `check_layers`; tests/layers/planted_includes.sh checks that it fails
+# on includes planted in a copy of the tree (CTest `check_layers_planted`).
 set -euo pipefail
 root="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 exec python3 - "$root" <<'PY'
@@ -22,13 +30,15 @@ import re
 import sys
 
 ROOT = os.path.abspath(sys.argv[1])
-ALLOWED_PLUGIN_MODULES = {"input", "method"}  # a plugin may include these framework modules
+SHARED_PLUGIN_FOLDER = "common"  # plugins/common/: what every plugin may include
 FORBIDDEN_MODULE_EDGES = {("pipeline", "rosbag")}  # (from, to): never
+APPLICATION_MODULE, APPLICATION_CALLERS = "app", {"cli"}  # framework/app/: included by cli/ (and python/) only
 SUFFIXES = (".h", ".hpp", ".c", ".cpp", ".cc", ".inl")
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
-SEARCH = [os.path.join(ROOT, p) for p in ("sdk/include", "framework", "plugins")]
+SEARCH = [os.path.join(ROOT, p) for p in ("sdk/include", "base", "framework", "plugins")]
+MODULAR = ("base", "framework")  # layers made of modules, one folder each
 
-for top in ("framework", "plugins", "sdk"):
+for top in ("sdk", "base", "framework", "plugins"):
     if not os.path.isdir(os.path.join(ROOT, top)):
         sys.exit(f"check-layers: {ROOT}: no {top}/ folder: expected the root of a Binocle tree")
 
@@ -51,16 +61,27 @@ def resolve(including, quote, path):
 
 
 def where(rel):
-    """(layer, module): ('framework', 'core'), ('plugins', 'sim'), ('sdk', None)."""
+    """(layer, module): ('framework', 'core'), ('base', 'input'), ('plugins', 'sim'), ('sdk', None)."""
     parts = rel.split(os.sep)
-    if parts[0] in ("framework", "plugins") and len(parts) > 2:
+    if parts[0] in MODULAR + ("plugins",) and len(parts) > 2:
         return parts[0], parts[1]
     return parts[0], None
 
 
 problems = []
 edges = {}  # (from module, to module) -> [(file, line, include)]
-for top in ("sdk", "plugins", "framework"):
+
+
+def modules_of(layer):
+    top = os.path.join(ROOT, layer)
+    return {d for d in os.listdir(top) if os.path.isdir(os.path.join(top, d))}
+
+
+for name in sorted(modules_of("base") & modules_of("framework")):
+    problems.append(f"base/{name}/ and framework/{name}/: one module name in two layers; "
+                    f'"{name}/..." includes would find one of them by the search order alone: rename one')
+
+for top in ("sdk", "base", "plugins", "framework"):
     for f in files_under(top):
         rel = os.path.relpath(f, ROOT)
         layer, module = where(rel)
@@ -75,15 +96,24 @@ for top in ("sdk", "plugins", "framework"):
                 to_layer, to_module = where(target)
                 close = ">" if m.group(1) == "<" else '"'
                 at = f"{rel}:{number}: #include {m.group(1)}{m.group(2)}{close}"
-                if layer == "sdk" and to_layer in ("framework", "plugins"):
+                if layer == "sdk" and to_layer != "sdk":
                     problems.append(f"{at} ({target}): the SDK includes {to_layer}/; the SDK must stand alone")
-                elif layer == "plugins" and to_layer == "framework" and to_module not in ALLOWED_PLUGIN_MODULES:
-                    allowed = ", ".join(f"framework/{m}" for m in sorted(ALLOWED_PLUGIN_MODULES))
+                elif layer == "base" and to_layer not in ("sdk", "base"):
+                    problems.append(f"{at} ({target}): base/{module}/ includes {to_layer}/; "
+                                    "the base layer may include the SDK and base/ only")
+                elif layer == "plugins" and to_layer == "framework":
                     problems.append(f"{at} ({target}): plugin '{module}' includes framework/{to_module}/; "
-                                    f"a plugin may include the SDK and {allowed} only")
-                elif layer == "framework" and to_layer == "framework" and module and to_module and module != to_module:
+                                    f"a plugin may include the SDK, base/ and plugins/{SHARED_PLUGIN_FOLDER}/ only")
+                elif layer == "plugins" and to_layer == "plugins" and to_module not in (module, SHARED_PLUGIN_FOLDER):
+                    problems.append(f"{at} ({target}): plugin '{module}' includes plugins/{to_module}/; "
+                                    f"a plugin may include the SDK, base/ and plugins/{SHARED_PLUGIN_FOLDER}/ only")
+                elif (layer == "framework" and to_layer == "framework" and to_module == APPLICATION_MODULE
+                      and module not in APPLICATION_CALLERS | {APPLICATION_MODULE}):
+                    problems.append(f"{at} ({target}): framework/{module}/ includes framework/{APPLICATION_MODULE}/; "
+                                    f"the application layer is called by framework/cli/ and python/ only")
+                elif layer in MODULAR and to_layer in MODULAR and module and to_module and module != to_module:
                     if (module, to_module) in FORBIDDEN_MODULE_EDGES:
-                        problems.append(f"{at} ({target}): framework/{module}/ includes framework/{to_module}/; "
+                        problems.append(f"{at} ({target}): {layer}/{module}/ includes {to_layer}/{to_module}/; "
                                         f"{to_module}/ builds on {module}/, never the reverse")
                     edges.setdefault((module, to_module), []).append(at)
 
@@ -160,7 +190,7 @@ def acyclic(inside, without):
 
 
 def cycle_report(cycle):
-    lines = [f"include cycle between framework modules: {' -> '.join(cycle)}"]
+    lines = [f"include cycle between modules (base/, framework/): {' -> '.join(cycle)}"]
     for a, b in zip(cycle, cycle[1:]):
         sites = edges[(a, b)]
         more = f" (and {len(sites) - 1} more)" if len(sites) > 1 else ""
@@ -197,7 +227,7 @@ if problems:
     print(f"check-layers: {len(problems)} problem(s) in {ROOT} (the layers: docs/DEVELOPING.md)")
     sys.exit(1)
 modules = sorted(graph)
-print(f"check-layers: ok: {sum(len(v) for v in edges.values())} includes between {len(modules)} framework modules, "
-      "no cycle; sdk/ stands alone; plugins use framework/ only through "
-      + ", ".join(sorted(ALLOWED_PLUGIN_MODULES)))
+print(f"check-layers: ok: {sum(len(v) for v in edges.values())} includes between {len(modules)} modules of base/ and "
+      "framework/, no cycle; sdk/ stands alone; base/ uses the SDK only; plugins use the SDK, base/ and "
+      f"plugins/{SHARED_PLUGIN_FOLDER}/ only; framework/{APPLICATION_MODULE}/ is included by cli/ only")
 PY

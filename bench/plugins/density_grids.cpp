@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // density_grids: a benchmark-only evaluator that bins the ground-frame cloud into the
-// three density grids of the paper's program (framework/method), the last step of the
+// three density grids of the paper's program (base/method), the last step of the
 // serial loop that bench_pipeline.cpp compares the pipeline with.
 #include "method/density_grid.hpp"
 

@@ -4,13 +4,14 @@
 #include "app/design.hpp"
 
 #include "app/data_file.hpp"
-#include "core/atomic_file.hpp"
 #include "core/output_folder.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/predictor_choice.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
 #include "method/predictors.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -44,8 +45,8 @@ std::vector<double> numberList(const Caller &caller, const std::string &name, co
         const std::string item = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
         double v = 0;
         std::string why;
-        if (!input::parseReal(item, v, &why)) // decimal and finite: no "nan", "inf" or "0x1p3"
-            throw RequestError(shown + ": '" + input::printable(item) + "' is not valid: " + why + " (e.g. " + exampleOf(name) + ")");
+        if (!sdk::parseDecimalReal(item, v, &why)) // decimal and finite: no "nan", "inf" or "0x1p3"
+            throw RequestError(shown + ": '" + sdk::printable(item) + "' is not valid: " + why + " (e.g. " + exampleOf(name) + ")");
         out.push_back(v);
         if (end == std::string::npos) return out;
         start = end + 1;

@@ -2,7 +2,7 @@
 // The caller's spelling of its arguments; the stop flag of a job.
 #include "app/request.hpp"
 
-#include "input/text.hpp"
+#include <binocle/text.hpp>
 
 #include <algorithm>
 
@@ -16,7 +16,7 @@ std::string Caller::arg(const std::string &name) const {
 }
 
 std::string Caller::shown(const std::string &name, const std::string &value) const {
-    const std::string text = input::printable(value);
+    const std::string text = sdk::printable(value);
     return python() ? name + "='" + text + "'" : arg(name) + " " + text;
 }
 

@@ -3,8 +3,9 @@
 #include "calibration/board.hpp"
 
 #include "core/error.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
+
+#include <binocle/text.hpp>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -28,7 +29,7 @@ BoardSpec BoardSpec::parse(const std::string &board, double square_mm) {
     // COLSxROWS, each count read by the one number reader: "09x6" is refused like any
     // number with a leading zero, not read as 9.
     const auto x = board.find_first_of("xX");
-    const std::string shown = input::printable(board);
+    const std::string shown = sdk::printable(board);
     if (x == std::string::npos)
         throw Error("--board '" + shown + "': expected COLSxROWS, the inner corners per row and per column, e.g. 9x6");
     BoardSpec b;
@@ -37,7 +38,7 @@ BoardSpec BoardSpec::parse(const std::string &board, double square_mm) {
         int64_t v = 0;
         std::string why;
         if (!input::parseInteger(text, v, &why, 0, 999))
-            throw Error("--board '" + shown + "': '" + input::printable(text) + "' is not valid: " + why +
+            throw Error("--board '" + shown + "': '" + sdk::printable(text) + "' is not valid: " + why +
                         " (COLSxROWS, the inner corners per row and per column, e.g. 9x6)");
         *count = static_cast<int>(v);
     }

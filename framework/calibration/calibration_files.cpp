@@ -2,7 +2,7 @@
 // Calibration outputs: configuration name, ROS camera_info YAML, writing the set.
 #include "calibration/calibration_files.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 
 #include <cmath>

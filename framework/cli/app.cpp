@@ -2,10 +2,9 @@
 // The `binocle` command line as one CLI11 app: registry, global options, shared helpers.
 #include "cli/command.hpp"
 
-#include "input/numbers.hpp"
-#include "input/text.hpp"
-
 #include <binocle/abi.h>
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <climits>
 #include <cmath>
@@ -95,8 +94,8 @@ CLI::Validator wholeNumberValidator(long long min, long long max, std::string ex
         [min, max, expected](std::string &text) -> std::string {
             int64_t v = 0;
             std::string why;
-            if (!input::parseInteger(text, v, &why) || v < min || v > max)
-                return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
+            if (!sdk::parseDecimalInteger(text, v, &why) || v < min || v > max)
+                return "'" + sdk::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
             return "";
         },
         "");
@@ -108,8 +107,8 @@ CLI::Validator numberValidator(std::function<bool(double)> fits, std::string exp
         [fits = std::move(fits), expected](std::string &text) -> std::string {
             double v = 0;
             std::string why;
-            if (!input::parseReal(text, v, &why) || !fits(v))
-                return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
+            if (!sdk::parseDecimalReal(text, v, &why) || !fits(v))
+                return "'" + sdk::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
             return "";
         },
         "");
@@ -145,8 +144,8 @@ CLI::Validator wholeNumbers(char separator, long long min) {
                 if (end == std::string::npos) end = text.size();
                 int64_t v = 0;
                 std::string why;
-                if (!input::parseInteger(std::string_view(text).substr(start, end - start), v, &why) || v < min)
-                    return "'" + input::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
+                if (!sdk::parseDecimalInteger(std::string_view(text).substr(start, end - start), v, &why) || v < min)
+                    return "'" + sdk::printable(text) + "': expected " + expected + sdk::numberWhyDetail(why);
                 start = end + 1;
             }
             return "";

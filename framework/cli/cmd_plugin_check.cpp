@@ -3,7 +3,7 @@
 // plugin authors; thin parsing only.
 #include "cli/command.hpp"
 #include "conformance/conformance.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 
 #include <iostream>
 

@@ -2,9 +2,10 @@
 // `binocle view RIG.yaml`: the rig's pipeline with a live web page on this machine.
 #include "cli/command.hpp"
 #include "core/output_folder.hpp"
-#include "input/text.hpp"
 #include "viewer/viewer.hpp"
 #include "viewer/web_guard.hpp"
+
+#include <binocle/text.hpp>
 
 #include <arpa/inet.h>
 
@@ -27,7 +28,7 @@ struct ViewArgs {
 void checkBind(const viewer::ViewOptions &o) {
     unsigned char bytes[16];
     if (::inet_pton(AF_INET, o.address.c_str(), bytes) != 1 && ::inet_pton(AF_INET6, o.address.c_str(), bytes) != 1)
-        throw UsageError("--bind " + input::printable(o.address) + ": expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
+        throw UsageError("--bind " + sdk::printable(o.address) + ": expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
     if (const std::string refusal = viewer::remoteBindRefusal(o.address, o.allow_remote); !refusal.empty())
         throw UsageError(refusal);
 }

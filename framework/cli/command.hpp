@@ -92,7 +92,7 @@ std::function<Runner(CLI::App &app)> defineOnRig(Options options, Run run) {
 CLI::Option *addFramesOption(CLI::App &app, int64_t &frames, const std::string &help);
 // Validators with messages in the words of the other errors. Every numeric option takes
 // one of these, before any other check: they read the text with the one number reader
-// (input/numbers.hpp: decimal only), so that `--frames 010` is an error, as in a rig
+// (binocle/numbers.hpp: decimal only), so that `--frames 010` is an error, as in a rig
 // file, and not 8 (CLI11 alone detects a base: "010" -> 8, "0x10" -> 16).
 CLI::Validator atLeast(long long min);   // a whole number >= min
 CLI::Validator wholeNumber();            // any whole number (then e.g. CLI::Range)

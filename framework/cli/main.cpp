@@ -4,7 +4,7 @@
 #include "config/rig_config.hpp"
 #include "core/log.hpp"
 #include "input/image_file.hpp"
-#include "input/text.hpp"
+#include "input/names.hpp"
 
 #include <spdlog/spdlog.h>
 

@@ -4,11 +4,12 @@
 
 #include "core/error.hpp"
 #include "host/plugin_kinds.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
+#include "input/names.hpp"
 #include "input/yaml_file.hpp"
 
 #include <binocle/settings.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <iterator>
@@ -97,7 +98,7 @@ struct Context {
 
 // A value as it reads in a message: control characters escaped, long values cut.
 std::string scalarText(const YAML::Node &n) {
-    if (n.IsScalar()) return input::printable(n.Scalar());
+    if (n.IsScalar()) return sdk::printable(n.Scalar());
     if (!n.IsDefined() || n.IsNull()) return "(nothing)";
     return n.IsMap() ? "(a map)" : "(a list)";
 }
@@ -443,7 +444,7 @@ void applyOverride(YAML::Node &root, const Override &o) {
         int64_t i = 0;
         const int64_t last = static_cast<int64_t>(list.size()) - 1;
         if (!input::parseInteger(part, i, nullptr, 0, last))
-            throw OverrideError(labelOf(o) + ": '" + input::printable(part) + "' is not an index of the list (" +
+            throw OverrideError(labelOf(o) + ": '" + sdk::printable(part) + "' is not an index of the list (" +
                         (last < 0 ? std::string("the list is empty") : "0.." + std::to_string(last)) + ")");
         return static_cast<size_t>(i);
     };

@@ -10,7 +10,7 @@
 #include "host/isolation.hpp"
 #include "host/plugin_host.hpp"
 #include "host/plugin_kinds.hpp"
-#include "input/text.hpp"
+#include "input/utf8.hpp"
 
 #include <algorithm>
 #include <chrono>

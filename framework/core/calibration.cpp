@@ -2,13 +2,14 @@
 // Stereo calibration file: read, write, rectify.
 #include "core/calibration.hpp"
 
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
-
+#include "files/atomic_file.hpp"
 #include "input/image_file.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -72,7 +73,7 @@ std::string number(double v) {
 // A calibration's text is read with the strict YAML loader and these readers, not with
 // OpenCV's FileStorage: FileStorage trusts its input, and on some mangled files (well-formed
 // YAML included) it never returns; found by fuzzing, tests/data/bad_calibration/. Numbers
-// go through the one strict reader (input::parseReal), sizes are checked before anything
+// go through the one strict reader (sdk::parseDecimalReal), sizes are checked before anything
 // is allocated, and the messages say where ("file:line:column").
 
 // One value of a calibration as a real number; .nan and .inf are read (and refused where
@@ -80,9 +81,9 @@ std::string number(double v) {
 double readReal(const YAML::Node &n, const std::string &what, const std::string &origin) {
     double v = 0;
     std::string why;
-    if (!n.IsScalar() || !input::parseReal(n.Scalar(), v, &why, true))
+    if (!n.IsScalar() || !sdk::parseDecimalReal(n.Scalar(), v, &why, true))
         throw Error(input::located(n, origin) + ": calibration key " + what +
-                    (n.IsScalar() ? " = '" + input::printable(n.Scalar(), 40) + "': " + why : ": expected a number"));
+                    (n.IsScalar() ? " = '" + sdk::printable(n.Scalar(), 40) + "': " + why : ": expected a number"));
     return v;
 }
 
@@ -121,7 +122,7 @@ cv::Mat readMatrix(const YAML::Node &root, const char *key, int rows, int cols, 
     if (size[0] * size[1] > 16) throw Error(notMatrix);
     if (const YAML::Node dt = n["dt"]; dt && !(dt.IsScalar() && (dt.Scalar() == "d" || dt.Scalar() == "f")))
         throw Error(input::located(dt, origin) + ": calibration key " + name + ": dt '" +
-                    input::printable(dt.IsScalar() ? dt.Scalar() : std::string("(not a scalar)"), 20) +
+                    sdk::printable(dt.IsScalar() ? dt.Scalar() : std::string("(not a scalar)"), 20) +
                     "': expected d (double) or f (float)");
     const YAML::Node data = n["data"];
     const auto total = static_cast<size_t>(size[0] * size[1]);
@@ -262,7 +263,7 @@ StereoCalibration StereoCalibration::fromYaml(const std::string &text, const std
     // Where a published calibration came from (replay: the bag and its CameraInfo topics):
     // every message below names it.
     if (const YAML::Node from = root["source"]; from && from.IsScalar())
-        origin += " (" + input::printable(from.Scalar(), 400) + ")";
+        origin += " (" + sdk::printable(from.Scalar(), 400) + ")";
     // The keys written by toYaml() (R1 ... Q, baseline_mm and focal_length_px are derived:
     // read again from M1 ... T, not from the file); any other key is a mistake.
     if (const auto unknown = input::findUnknownKey(root, {"image_width", "image_height", "configuration", "rectified", "M1", "D1",

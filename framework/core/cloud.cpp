@@ -2,11 +2,12 @@
 // Point clouds: triangulation from disparity and binary PLY.
 #include "core/cloud.hpp"
 
-#include "core/atomic_file.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
+#include "input/integer_range.hpp"
+
+#include <binocle/text.hpp>
 
 #include <cstring>
 #include <fstream>
@@ -166,7 +167,7 @@ Cloud readPly(const std::string &path) {
             std::string why;
             // The data must hold them: at most as many vertices as there are bytes.
             if (!input::parseInteger(line.substr(15), count, &why, 0, static_cast<int64_t>(bytes.size())))
-                throw Error(path + ": PLY header: element vertex '" + input::printable(line.substr(15)) + "' is not valid: " + why);
+                throw Error(path + ": PLY header: element vertex '" + sdk::printable(line.substr(15)) + "' is not valid: " + why);
             n = static_cast<size_t>(count);
         }
         if (line == "property uchar red") color = true;

@@ -1,17 +1,13 @@
 // SPDX-License-Identifier: MIT
-// Errors the framework throws; the CLI prints what() and exits non-zero.
+// Errors the framework throws; the CLI prints what() and exits non-zero. binocle::Error
+// itself lives in the base layer (base/error/error.hpp), which throws it too.
 #pragma once
 
-#include <stdexcept>
+#include "error/error.hpp"
+
 #include <string>
 
 namespace binocle {
-
-// Something the user can fix: a file, a key, a value, a device. what() names them.
-class Error : public std::runtime_error {
-public:
-    explicit Error(const std::string &message) : std::runtime_error(message) {}
-};
 
 // A plugin refused a call or misbehaved; what() names the plugin and carries its message.
 class PluginError : public Error {

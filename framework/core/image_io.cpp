@@ -2,7 +2,7 @@
 // Disparity image formats: KITTI 16-bit PNG, PFM, colourised PNG.
 #include "core/image_io.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "input/image_file.hpp"
 

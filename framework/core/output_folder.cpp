@@ -2,7 +2,7 @@
 // Output-folder ownership: a lock file held with flock, and the kind of output a folder holds.
 #include "core/output_folder.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 
 #include <algorithm>

@@ -5,11 +5,14 @@
 #include "experiment/test_rig.hpp"
 
 #include "config/rig_config.hpp"
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
+#include "input/integer_range.hpp"
+#include "input/names.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -46,12 +49,12 @@ struct Reader {
         if (!map.IsMap()) fail(map, what + ": expected a map");
         if (auto unknown = input::findUnknownKey(map, valid)) fail(unknown->key, what + ": " + unknown->message);
     }
-    // One strict reader of numbers (input/numbers.hpp): decimal, finite.
+    // One strict reader of numbers (binocle/numbers.hpp): decimal, finite.
     double number(const YAML::Node &n, const std::string &what) const {
         double v = 0;
         std::string why;
-        if (!n.IsScalar() || !input::parseReal(n.Scalar(), v, &why))
-            fail(n, what + ": value '" + (n.IsScalar() ? input::printable(n.Scalar()) : std::string("(not a scalar)")) +
+        if (!n.IsScalar() || !sdk::parseDecimalReal(n.Scalar(), v, &why))
+            fail(n, what + ": value '" + (n.IsScalar() ? sdk::printable(n.Scalar()) : std::string("(not a scalar)")) +
                         "' is not valid: " + (why.empty() ? "expected a number" : why));
         return v;
     }
@@ -148,7 +151,7 @@ void checkRigShape(const YAML::Node &rig, const std::string &file, const std::st
     const std::string expected = "expected a rig: a YAML map with source: {plugin: NAME, ...} and matcher: {plugin: NAME, ...}";
     if (!rig.IsMap()) throw Error(namedAt + ": " + file + " is not a rig (" + expected + ")");
     std::vector<std::string> keys;
-    for (const auto &kv : rig) keys.push_back(kv.first.IsScalar() ? input::printable(kv.first.Scalar(), 40) : "(not a text)");
+    for (const auto &kv : rig) keys.push_back(kv.first.IsScalar() ? sdk::printable(kv.first.Scalar(), 40) : "(not a text)");
     for (const char *block : {"source", "matcher"}) {
         const YAML::Node b = rig[block];
         if (!b.IsDefined())
@@ -158,7 +161,7 @@ void checkRigShape(const YAML::Node &rig, const std::string &file, const std::st
                                                                std::to_string(b.Mark().column + 1);
         if (!b.IsMap() || !b["plugin"].IsDefined() || !b["plugin"].IsScalar())
             throw Error(at + ": " + block + ": value " +
-                        (b.IsScalar() ? "'" + input::printable(b.Scalar(), 40) + "'" : b.IsSequence() ? "(a list)" : "(empty)") +
+                        (b.IsScalar() ? "'" + sdk::printable(b.Scalar(), 40) + "'" : b.IsSequence() ? "(a list)" : "(empty)") +
                         " is not valid: expected a map with 'plugin: <name>' and the plugin's settings (e.g. " + block +
                         ": {plugin: " + (std::string(block) == "source" ? "sim" : "bm") + "})");
     }
@@ -224,7 +227,7 @@ YAML::Node datasetTests(const YAML::Node &root, const Reader &r) {
         for (const auto &n : pick) {
             const std::string name = r.text(n, "scenes");
             if (std::find(names.begin(), names.end(), name) == names.end())
-                r.fail(n, "scenes: '" + input::printable(name) + "' is not a folder of " + folder.string() + " (its folders: " +
+                r.fail(n, "scenes: '" + sdk::printable(name) + "' is not a folder of " + folder.string() + " (its folders: " +
                               join(names) + ")");
             scenes.push_back(folder / name);
         }
@@ -440,7 +443,7 @@ std::optional<double> rigNumber(const YAML::Node &rig, const std::string &path) 
         n = n.IsSequence() ? n[static_cast<size_t>(index)] : n[part];
     }
     double v = 0;
-    if (n.IsDefined() && n.IsScalar() && input::parseReal(n.Scalar(), v)) return v;
+    if (n.IsDefined() && n.IsScalar() && sdk::parseDecimalReal(n.Scalar(), v)) return v;
     return std::nullopt;
 }
 
@@ -488,7 +491,7 @@ ExperimentTest readTest(const Experiment &e, const YAML::Node &root, const YAML:
     t.line = tn.Mark().line + 1;
     // The id names the folder test_<id>/ under --out: it must stay a file name.
     if (std::string why; !input::isSafeName(t.id, &why))
-        r.fail(tn["id"], at + ".id '" + input::printable(t.id) + "': " + why + " (it names the folder test_<id>/ under --out)");
+        r.fail(tn["id"], at + ".id '" + sdk::printable(t.id) + "': " + why + " (it names the folder test_<id>/ under --out)");
     if (!ids.insert(t.id).second) r.fail(tn, "test " + t.id + ": id used twice");
     t.geometry = defaults.geometry;
     for (const auto &var : kVariables) {
@@ -556,7 +559,7 @@ void readCharts(Experiment &e, const YAML::Node &root, const Reader &r) {
         s.file = cn["file"] ? r.text(cn["file"], "charts.file") : s.metric + (s.type == "scatter" ? "_vs_" + s.x : "");
         // The chart is written as <--out>/<file>.png|svg: a file name, not a path.
         if (std::string why; !input::isSafeName(s.file, &why))
-            r.fail(cn["file"] ? cn["file"] : cn, "charts.file '" + input::printable(s.file) + "': " + why +
+            r.fail(cn["file"] ? cn["file"] : cn, "charts.file '" + sdk::printable(s.file) + "': " + why +
                                                      " (the chart's file name under --out, without extension)");
         if (cn["reference_lines"]) s.reference_lines = r.numbers(cn["reference_lines"], "charts.reference_lines");
         e.charts.push_back(s);
@@ -574,7 +577,7 @@ Experiment loadWith(const std::string &file, const PluginHost &host, const std::
     e.name = root["name"] ? r.text(root["name"], "name") : fs::path(e.file).stem().string();
     // The name makes the default output folder out/<name>: it must stay one file name.
     if (std::string why; !input::isSafeName(e.name, &why))
-        r.fail(root["name"], "name '" + input::printable(e.name) + "': " + why + " (it names the default output folder out/<name>)");
+        r.fail(root["name"], "name '" + sdk::printable(e.name) + "': " + why + " (it names the default output folder out/<name>)");
     e.description = root["description"] ? r.text(root["description"], "description") : "";
     readRig(e, root, r);
     readHead(e, root, r, host);

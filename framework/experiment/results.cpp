@@ -2,11 +2,11 @@
 // results.csv and results.json of an experiment, and the rows they hold.
 #include "experiment/results.hpp"
 
-#include "core/atomic_file.hpp"
 #include "experiment/test_rig.hpp"
+#include "files/atomic_file.hpp"
 #include "host/plugin_host.hpp"
 #include "host/plugin_kinds.hpp"
-#include "input/text.hpp"
+#include "input/names.hpp"
 #include "method/statistics.hpp"
 
 #include <algorithm>
@@ -100,7 +100,7 @@ OJson predictorRho(const std::vector<Row> &rows) {
     out["best"] = best.empty() ? OJson() : OJson(best);
     out["note"] = "each predictor as a score where higher should mean better: ff_band = -(log distance of FF from "
                   "1.2-2.0), depth_resolution = -dR/R, sensor_aware = eta_3d predicted from the design "
-                  "(framework/method/predictors.hpp)";
+                  "(base/method/predictors.hpp)";
     return out;
 }
 

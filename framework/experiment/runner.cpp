@@ -9,12 +9,13 @@
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
 #include "method/design.hpp"
 #include "method/predictors.hpp"
 #include "method/statistics.hpp"
 #include "pipeline/pipeline.hpp"
+
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -221,9 +222,9 @@ std::pair<int, int> parseShard(const std::string &text) {
     std::string why;
     if (slash == std::string::npos || !input::parseInteger(text.substr(0, slash), k, &why, 1, 1000000) ||
         !input::parseInteger(text.substr(slash + 1), n, &why, 1, 1000000))
-        throw Error("--shard " + input::printable(text) + ": expected K/N, e.g. --shard 2/8 (the second of eight shares)" +
+        throw Error("--shard " + sdk::printable(text) + ": expected K/N, e.g. --shard 2/8 (the second of eight shares)" +
                     (why.empty() ? "" : "; " + why));
-    if (k > n) throw Error("--shard " + input::printable(text) + ": expected 1 <= K <= N");
+    if (k > n) throw Error("--shard " + sdk::printable(text) + ": expected 1 <= K <= N");
     return {static_cast<int>(k), static_cast<int>(n)};
 }
 
@@ -234,7 +235,7 @@ std::vector<const ExperimentTest *> selectTests(const Experiment &e, const Exper
         if (std::none_of(e.tests.begin(), e.tests.end(), [&](const ExperimentTest &t) { return t.id == id; })) {
             std::vector<std::string> ids;
             for (const auto &t : e.tests) ids.push_back(t.id);
-            throw Error("--tests " + join(options.only) + ": experiment " + e.file + " has no test '" + input::printable(id) +
+            throw Error("--tests " + join(options.only) + ": experiment " + e.file + " has no test '" + sdk::printable(id) +
                         "' (its tests: " + join(ids) + ")");
         }
     std::vector<const ExperimentTest *> selected;

@@ -6,8 +6,9 @@
 #include "config/rig_config.hpp"
 #include "core/error.hpp"
 #include "host/plugin_kinds.hpp"
-#include "input/numbers.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -120,7 +121,7 @@ std::optional<double> settingDefault(const YAML::Node &rig, const std::string &p
     const auto table = settingsOf(nodeAt(rig, path.substr(0, dot)), kind, host);
     const auto *d = setting(table, path.substr(dot + 1));
     double v = 0;
-    if (d && d->default_value && input::parseReal(d->default_value, v)) return v;
+    if (d && d->default_value && sdk::parseDecimalReal(d->default_value, v)) return v;
     return std::nullopt;
 }
 

@@ -9,7 +9,7 @@
 #include "pipeline/pipeline_run.hpp"
 
 #include "calibration/geometry_check.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
 #include "core/json.hpp"

@@ -4,7 +4,7 @@
 // and the loop that records a rig's source into any RecordingSink.
 #include "pipeline/recorder.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"

@@ -2,9 +2,9 @@
 // Charts: one layout, drawn on two canvases (SVG text and an OpenCV image).
 #include "report/chart.hpp"
 
-#include "core/atomic_file.hpp"
 #include "core/image_io.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
+#include "input/utf8.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -2,11 +2,14 @@
 // The HTML report of an experiment, built from its output folder.
 #include "report/html_report.hpp"
 
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
+#include "input/names.hpp"
+#include "input/utf8.hpp"
 #include "report/chart.hpp"
 #include "report/web_files.hpp"
+
+#include <binocle/text.hpp>
 
 #include <boost/beast/core/detail/base64.hpp>
 #include <spdlog/spdlog.h>
@@ -436,7 +439,7 @@ std::string writeExperimentReport(const std::string &dirText, const std::string 
         if (!row.is_object() || !row.contains("test") || !row["test"].is_string() ||
             !input::isSafeName(row["test"].get<std::string>(), &why))
             throw Error("report: " + resultsPath.string() + ": tests[" + std::to_string(i) + "].test " +
-                        (row.is_object() && row.contains("test") ? input::printable(row["test"].dump(), 60) : "(missing)") +
+                        (row.is_object() && row.contains("test") ? sdk::printable(row["test"].dump(), 60) : "(missing)") +
                         " is not valid: " + why + " (the id of a test, which names its folder test_<id>/)");
     }
     const std::string output = outputText.empty() ? (dir / "report.html").string()

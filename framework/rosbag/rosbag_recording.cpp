@@ -2,7 +2,7 @@
 // RosbagRecordingWriter: the recorder's queue in front of one RosbagWriter.
 #include "rosbag/rosbag_recording.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "pipeline/recorder.hpp"
 

@@ -2,12 +2,12 @@
 // RosbagWriter: Binocle's images, disparities, clouds and figures as a rosbag2 MCAP bag.
 #include "rosbag/rosbag_writer.hpp"
 
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
-#include "input/text.hpp"
+#include "files/atomic_file.hpp"
 
 #include <binocle/ros2_messages.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -77,7 +77,7 @@ std::string namespaceProblem(const std::string &ns) {
         const std::string token = ns.substr(start, end - start);
         if (token.empty()) return "it holds '//' (an empty name)";
         if (std::isdigit(static_cast<unsigned char>(token[0]))) return "the name '" + token + "' starts with a digit";
-        if (!rosName(token, false)) return "the name '" + input::printable(token) + "' holds a character other than letters, digits and '_'";
+        if (!rosName(token, false)) return "the name '" + sdk::printable(token) + "' holds a character other than letters, digits and '_'";
         start = end + 1;
     }
     return "";
@@ -86,7 +86,7 @@ std::string namespaceProblem(const std::string &ns) {
 std::string rosNamespaceRefusal(const std::string &ns) {
     const std::string why = namespaceProblem(ns);
     if (why.empty()) return "";
-    return "'" + input::printable(ns) + "': " + why + "; ROS 2 expects '/' followed by names of letters, digits and '_' "
+    return "'" + sdk::printable(ns) + "': " + why + "; ROS 2 expects '/' followed by names of letters, digits and '_' "
            "that do not start with a digit, joined by single '/' (e.g. /vehicle/stereo)";
 }
 
@@ -94,7 +94,7 @@ void checkRosbagOptions(const RosbagOptions &o) {
     if (const std::string why = rosNamespaceRefusal(o.ros_namespace); !why.empty()) throw Error("--ros-namespace " + why);
     for (const auto *f : {&o.frame_id_left, &o.frame_id_right, &o.frame_id_ground})
         if (!rosName(*f, true))
-            throw Error("frame id '" + input::printable(*f) + "': expected letters, digits, '_' and '/' (e.g. stereo_left_optical)");
+            throw Error("frame id '" + sdk::printable(*f) + "': expected letters, digits, '_' and '/' (e.g. stereo_left_optical)");
 }
 
 RosbagWriter::RosbagWriter(const std::string &dir, const std::optional<StereoCalibration> &calibration,

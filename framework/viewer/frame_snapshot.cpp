@@ -3,7 +3,7 @@
 // message the page reads, and snapshots on disk.
 #include "viewer/frame_snapshot.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/image_io.hpp"
 #include "method/density_render.hpp"

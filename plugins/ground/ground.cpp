@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // ground: CloudTransform moving a cloud from the camera frame into the ground frame (Eq. 1).
-#include "ground/ground_frame.hpp"
+#include "method/ground_frame.hpp"
 
 #include <binocle/plugin.hpp>
 
@@ -50,7 +50,7 @@ public:
     }
 
 private:
-    binocle::ground::GroundFrame frame_;
+    binocle::method::GroundFrame frame_;
 };
 
 } // namespace

@@ -2,7 +2,7 @@
 // The oracle cloud from the frame's ground-truth disparity (oracle_cloud.hpp).
 #include "paper/oracle_cloud.hpp"
 
-#include "ground/ground_frame.hpp"
+#include "method/ground_frame.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -40,7 +40,7 @@ std::optional<std::vector<float>> OracleProjector::groundCloud(const binocle_ste
             frame->extras[i].image.format == BINOCLE_PIXEL_FLOAT32)
             gt = &frame->extras[i].image;
     if (!gt || !gt->data) return std::nullopt;
-    const ground::GroundFrame eq1(hc, theta);
+    const method::GroundFrame eq1(hc, theta);
     std::vector<float> xyz;
     xyz.reserve(static_cast<size_t>(gt->width) * gt->height * 3);
     for (int v = 0; v < gt->height; ++v) {

@@ -13,7 +13,6 @@
 
 #include "common/frame_pacer.hpp"
 #include "input/image_file.hpp"
-#include "input/text.hpp"
 
 #include <binocle/plugin.hpp>
 #include <binocle/recording.hpp>

@@ -3,10 +3,10 @@
 #include "replay_metadata.hpp"
 
 #include "input/image_file.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
 
+#include <binocle/numbers.hpp>
 #include <binocle/plugin.hpp>
+#include <binocle/text.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -56,8 +56,8 @@ std::vector<double> numbersIn(std::string text, const std::string &where) {
     for (std::string token; in >> token;) {
         double v = 0;
         std::string why;
-        if (!input::parseReal(token, v, &why))
-            refuse(where + ": '" + input::printable(token, 40) + "' is not a number: " + why);
+        if (!sdk::parseDecimalReal(token, v, &why))
+            refuse(where + ": '" + sdk::printable(token, 40) + "' is not a number: " + why);
         out.push_back(v);
     }
     return out;
@@ -98,13 +98,13 @@ MiddleburyCalib parseMiddleburyCalib(const std::string &text, const std::string 
         const std::string here = origin + ":" + std::to_string(number);
         if (line.find_first_not_of(" \t") == std::string::npos) continue;
         const auto eq = line.find('=');
-        if (eq == std::string::npos) refuse(here + ": '" + input::printable(line) + "': expected key=value");
+        if (eq == std::string::npos) refuse(here + ": '" + sdk::printable(line) + "': expected key=value");
         const std::string key = trim(line.substr(0, eq));
         auto [it, fresh] = values.try_emplace(key);
         if (!fresh)
-            refuse(here + ": key '" + input::printable(key) + "' given twice (first on line " +
+            refuse(here + ": key '" + sdk::printable(key) + "' given twice (first on line " +
                    std::to_string(it->second.second) + ")");
-        it->second = {numbersIn(line.substr(eq + 1), here + ": '" + input::printable(key) + "'"), number};
+        it->second = {numbersIn(line.substr(eq + 1), here + ": '" + sdk::printable(key) + "'"), number};
     }
     auto numbers = [&](const std::string &key, size_t count, bool required) -> std::vector<double> {
         auto it = values.find(key);
@@ -155,9 +155,9 @@ std::optional<KittiCalib> parseKittiCalib(const std::string &text, const std::st
         if (!wanted) continue;
         auto [it, fresh] = values.try_emplace(key);
         if (!fresh)
-            refuse(here + ": key '" + input::printable(key) + "' given twice (first on line " +
+            refuse(here + ": key '" + sdk::printable(key) + "' given twice (first on line " +
                    std::to_string(it->second.second) + ")");
-        it->second = {numbersIn(lines[i].substr(colon + 1), here + ": '" + input::printable(key) + "'"),
+        it->second = {numbersIn(lines[i].substr(colon + 1), here + ": '" + sdk::printable(key) + "'"),
                       static_cast<int>(i + 1)};
     }
     auto projection = [&](int i, cv::Matx34d &P) {
@@ -221,8 +221,8 @@ void checkBaselineAgrees(double stated_mm, const std::string &stated_file, doubl
                          const std::string &calibration_file) {
     if (std::abs(stated_mm - calibration_mm) <= kBaselineTolerance * std::max(std::abs(stated_mm), std::abs(calibration_mm)))
         return;
-    refuse("calibration '" + input::printable(calibration_file, 200) + "' has a baseline of " +
-           number(calibration_mm) + " mm but '" + input::printable(stated_file, 200) + "' states " + number(stated_mm) +
+    refuse("calibration '" + sdk::printable(calibration_file, 200) + "' has a baseline of " +
+           number(calibration_mm) + " mm but '" + sdk::printable(stated_file, 200) + "' states " + number(stated_mm) +
            " mm for the same images; expected one baseline (within " + number(kBaselineTolerance * 100) +
            " %): fix the calibration, or leave `calibration` unset to use the files' own");
 }

@@ -5,9 +5,11 @@
 
 #include "random.hpp"
 
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <yaml-cpp/yaml.h>
 
@@ -41,7 +43,7 @@ BoardSettings BoardSettings::fromYaml(const std::string &text) {
             std::string why;
             if (!v.IsScalar() || !input::parseInteger(v.Scalar(), parsed, &why, min, max))
                 throw SceneError(input::located(v, origin) + ": " + origin + "." + key + " = '" +
-                                 (v.IsScalar() ? input::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
+                                 (v.IsScalar() ? sdk::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
                                  (why.empty() ? "expected a decimal integer" : why));
             out = static_cast<std::remove_reference_t<decltype(out)>>(parsed);
         };
@@ -49,9 +51,9 @@ BoardSettings BoardSettings::fromYaml(const std::string &text) {
             const YAML::Node v = n[key];
             if (!v) return;
             std::string why;
-            if (!v.IsScalar() || !input::parseReal(v.Scalar(), out, &why))
+            if (!v.IsScalar() || !sdk::parseDecimalReal(v.Scalar(), out, &why))
                 throw SceneError(input::located(v, origin) + ": " + origin + "." + key + " = '" +
-                                 (v.IsScalar() ? input::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
+                                 (v.IsScalar() ? sdk::printable(v.Scalar(), 40) : std::string("(not a scalar)")) + "': " +
                                  (why.empty() ? "expected a number" : why));
         };
         integer("cols", 2, 1000, b.cols);

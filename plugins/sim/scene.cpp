@@ -5,8 +5,10 @@
 
 #include "random.hpp"
 
-#include "input/numbers.hpp"
+#include "input/integer_range.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
 
 #include <yaml-cpp/yaml.h>
 
@@ -63,7 +65,7 @@ public:
     int integer(const YAML::Node &map, const std::string &key, int def, int min, const std::string &what) const {
         const YAML::Node n = map[key];
         if (!n) return def;
-        // The one strict reader (framework/input): decimal, within int, no octal "0640".
+        // The one strict reader (the SDK's, with base/input's range check): decimal, within int, no octal "0640".
         int64_t parsed = 0;
         if (!n.IsScalar() || !binocle::input::parseInteger(n.Scalar(), parsed, nullptr, INT32_MIN, INT32_MAX))
             fail(n, what + "." + key + " = '" + text(n) + "': expected a decimal integer");
@@ -139,7 +141,7 @@ public:
 private:
     double scalar(const YAML::Node &n, const std::string &what) const {
         double v = 0;
-        if (!n.IsScalar() || !binocle::input::parseReal(n.Scalar(), v))
+        if (!n.IsScalar() || !binocle::sdk::parseDecimalReal(n.Scalar(), v))
             fail(n, what + " = '" + text(n) + "': expected a finite decimal number");
         return v;
     }

@@ -2,7 +2,7 @@
 // The `binocle` command end to end: help, plugins, and a run on the real opencv-doc
 // pair checked against its ground-truth disparity.
 #include "common/test_util.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/cloud.hpp"
 #include "core/image_io.hpp"
 

@@ -2,10 +2,10 @@
 // Rig YAML: validation against plugin tables, errors with file:line:col, --set overrides.
 #include "common/test_util.hpp"
 #include "config/rig_config.hpp"
-#include "host/plugin_kinds.hpp"
-#include "input/text.hpp"
 #include "core/calibration.hpp"
 #include "core/error.hpp"
+#include "host/plugin_kinds.hpp"
+#include "input/names.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Experiments and design: validation before anything runs, tables and charts, ranking.
 #include "common/test_util.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "experiment/experiment.hpp"
 

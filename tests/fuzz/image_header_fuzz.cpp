@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Fuzz harness: image header checks (framework/input/image_file.cpp) for PNG, JPEG,
+// Fuzz harness: image header checks (base/input/image_file.cpp) for PNG, JPEG,
 // PFM, PGM/PPM and BMP. What the check accepts, OpenCV must decode to the size the
 // header gave (small images only: decoding is the slow part).
 #include "input/image_file.hpp"

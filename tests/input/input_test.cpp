@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: MIT
-// framework/input: the strict number reader, UTF-8 and path checks, image header checks
-// and the YAML loader.
+// base/input and the SDK readers it builds on: the strict number reader, UTF-8 and path
+// checks, image header checks and the YAML loader.
 #include "input/image_file.hpp"
-#include "input/numbers.hpp"
-#include "input/text.hpp"
+#include "input/integer_range.hpp"
+#include "input/names.hpp"
+#include "input/utf8.hpp"
 #include "input/yaml_file.hpp"
+
+#include <binocle/numbers.hpp>
+#include <binocle/text.hpp>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -17,36 +21,37 @@
 #include <sstream>
 
 using namespace binocle::input;
+namespace sdk = binocle::sdk;
 
 namespace {
 
 TEST(Numbers, IntegersAreDecimalWholeAndInRange) {
     int64_t v = 0;
     std::string why;
-    EXPECT_TRUE(parseInteger("640", v) && v == 640);
-    EXPECT_TRUE(parseInteger("-7", v) && v == -7);
-    EXPECT_TRUE(parseInteger("+7", v) && v == 7);
-    EXPECT_TRUE(parseInteger("0", v) && v == 0);
-    EXPECT_TRUE(parseInteger("-9223372036854775808", v) && v == INT64_MIN);
-    EXPECT_FALSE(parseInteger("0640", v, &why));
+    EXPECT_TRUE(sdk::parseDecimalInteger("640", v) && v == 640);
+    EXPECT_TRUE(sdk::parseDecimalInteger("-7", v) && v == -7);
+    EXPECT_TRUE(sdk::parseDecimalInteger("+7", v) && v == 7);
+    EXPECT_TRUE(sdk::parseDecimalInteger("0", v) && v == 0);
+    EXPECT_TRUE(sdk::parseDecimalInteger("-9223372036854775808", v) && v == INT64_MIN);
+    EXPECT_FALSE(sdk::parseDecimalInteger("0640", v, &why));
     EXPECT_NE(why.find("leading zeros"), std::string::npos) << why;
     for (const char *bad : {"", "-", "0x10", "1e3", "12px", " 3", "3 ", "1.0", "9223372036854775808", "٣"})
-        EXPECT_FALSE(parseInteger(bad, v)) << bad;
+        EXPECT_FALSE(sdk::parseDecimalInteger(bad, v)) << bad;
     EXPECT_FALSE(parseInteger("17", v, &why, 0, 16));
     EXPECT_EQ(why, "expected an integer <= 16");
 }
 
 TEST(Numbers, RealsAreDecimalAndFiniteUnlessAsked) {
     double v = 0;
-    EXPECT_TRUE(parseReal("1.5", v) && v == 1.5);
-    EXPECT_TRUE(parseReal("-.5", v) && v == -0.5);
-    EXPECT_TRUE(parseReal("1e3", v) && v == 1000);
-    EXPECT_TRUE(parseReal("2.", v) && v == 2);
-    EXPECT_TRUE(parseReal("1e300", v) && v == 1e300);
+    EXPECT_TRUE(sdk::parseDecimalReal("1.5", v) && v == 1.5);
+    EXPECT_TRUE(sdk::parseDecimalReal("-.5", v) && v == -0.5);
+    EXPECT_TRUE(sdk::parseDecimalReal("1e3", v) && v == 1000);
+    EXPECT_TRUE(sdk::parseDecimalReal("2.", v) && v == 2);
+    EXPECT_TRUE(sdk::parseDecimalReal("1e300", v) && v == 1e300);
     for (const char *bad : {"", ".", "nan", ".nan", "inf", ".inf", "0x1p3", "1e", "1e999", "1,5", " 1", "1.5mm"})
-        EXPECT_FALSE(parseReal(bad, v)) << bad;
-    EXPECT_TRUE(parseReal(".inf", v, nullptr, true) && std::isinf(v));
-    EXPECT_TRUE(parseReal(".nan", v, nullptr, true) && std::isnan(v));
+        EXPECT_FALSE(sdk::parseDecimalReal(bad, v)) << bad;
+    EXPECT_TRUE(sdk::parseDecimalReal(".inf", v, nullptr, true) && std::isinf(v));
+    EXPECT_TRUE(sdk::parseDecimalReal(".nan", v, nullptr, true) && std::isnan(v));
     EXPECT_FALSE(fitsInt(1e300));
     EXPECT_FALSE(fitsInt(NAN));
     EXPECT_TRUE(fitsInt(-2147483648.0));
@@ -60,15 +65,15 @@ TEST(Numbers, RealsAreDecimalAndFiniteUnlessAsked) {
 TEST(Numbers, LeadingZerosAndPrefixesAreErrorsForRealsToo) {
     double v = 0;
     std::string why;
-    EXPECT_FALSE(parseReal("010", v, &why));
+    EXPECT_FALSE(sdk::parseDecimalReal("010", v, &why));
     EXPECT_EQ(why, "expected a decimal number without leading zeros (010 would read as octal 8 elsewhere: write 10)");
-    EXPECT_FALSE(parseReal("-00.5", v, &why));
+    EXPECT_FALSE(sdk::parseDecimalReal("-00.5", v, &why));
     EXPECT_NE(why.find("write -0.5"), std::string::npos) << why;
-    EXPECT_FALSE(parseReal("0x10", v, &why));
+    EXPECT_FALSE(sdk::parseDecimalReal("0x10", v, &why));
     EXPECT_EQ(why, "expected a decimal number (0x10 is hexadecimal: write 16)");
-    for (const char *good : {"0", "0.5", "-0.5", "0e0", "10", "1e05"}) EXPECT_TRUE(parseReal(good, v)) << good;
+    for (const char *good : {"0", "0.5", "-0.5", "0e0", "10", "1e05"}) EXPECT_TRUE(sdk::parseDecimalReal(good, v)) << good;
     int64_t i = 0;
-    EXPECT_FALSE(parseInteger("0x10", i, &why));
+    EXPECT_FALSE(sdk::parseDecimalInteger("0x10", i, &why));
     EXPECT_EQ(why, "expected a decimal integer (0x10 is hexadecimal: write 16)");
     EXPECT_FALSE(parseInteger("010", i, &why, 0, 100));
     EXPECT_NE(why.find("octal 8"), std::string::npos) << why;
@@ -83,12 +88,12 @@ TEST(Text, Utf8PathsAndNames) {
     EXPECT_FALSE(isValidUtf8("\xED\xA0\x80"));     // surrogate
     EXPECT_FALSE(isValidUtf8("\xF4\x90\x80\x80")); // > U+10FFFF
     EXPECT_EQ(sanitizeUtf8("r\xffg"), "r\xEF\xBF\xBDg");
-    EXPECT_EQ(printable("a\nb\x01"), "a\\nb\\x01");
-    EXPECT_EQ(printable(std::string(100, 'x'), 4), "xxxx... (100 bytes)");
-    EXPECT_TRUE(isConfinedRelativePath("left/000001.png"));
-    EXPECT_TRUE(isConfinedRelativePath("a..b/c"));
+    EXPECT_EQ(sdk::printable("a\nb\x01"), "a\\nb\\x01");
+    EXPECT_EQ(sdk::printable(std::string(100, 'x'), 4), "xxxx... (100 bytes)");
+    EXPECT_TRUE(sdk::isConfinedRelativePath("left/000001.png"));
+    EXPECT_TRUE(sdk::isConfinedRelativePath("a..b/c"));
     for (const char *bad : {"", "/etc/passwd", "../x", "a/../../b", "a/..", ".."})
-        EXPECT_FALSE(isConfinedRelativePath(bad)) << bad;
+        EXPECT_FALSE(sdk::isConfinedRelativePath(bad)) << bad;
     EXPECT_TRUE(isSafeName("e1-b150_f8.2"));
     for (const char *bad : {"", ".", "..", "/x", "a/b", "a b", "../x", ".hidden"}) EXPECT_FALSE(isSafeName(bad)) << bad;
 }

@@ -15,7 +15,7 @@ using namespace binocle::method;
 
 // Eq. 1 with hc = 1500 mm: hand-computed (cos 10 deg = 0.984807753, sin 10 deg = 0.173648178).
 TEST(Eq1, HandComputedPointsAtZeroAndTenDegrees) {
-    const ground::GroundFrame level(1500, 0), tilted(1500, 10);
+    const method::GroundFrame level(1500, 0), tilted(1500, 10);
     auto expectPoint = [](const std::array<double, 3> &g, double x, double y, double z) {
         EXPECT_NEAR(g[0], x, 1e-5);
         EXPECT_NEAR(g[1], y, 1e-5);

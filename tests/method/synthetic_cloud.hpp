@@ -3,7 +3,7 @@
 // panel (front faces of 3 x 3 cubes), a flat ground, boxes, outliers, and distortions.
 #pragma once
 
-#include "ground/ground_frame.hpp"
+#include "method/ground_frame.hpp"
 
 #include <cmath>
 #include <random>
@@ -94,7 +94,7 @@ inline std::vector<float> groundSeenWithInclination(double hc, double trueDeg, d
     std::mt19937 rng(seed);
     std::normal_distribution<double> n(0, noise > 0 ? noise : 1e-9);
     const double t = trueDeg * 3.14159265358979323846 / 180, c = std::cos(t), sn = std::sin(t);
-    const ground::GroundFrame applied(hc, appliedDeg);
+    const method::GroundFrame applied(hc, appliedDeg);
     std::vector<float> xyz;
     for (double x = -4000; x <= 4000; x += 100)
         for (double y = 2000; y <= 15000; y += 100) {

@@ -3,7 +3,7 @@
 // core/output_folder.hpp on its own, and `binocle run` racing another run or aimed at a
 // recording.
 #include "common/test_util.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/output_folder.hpp"
 #include "spawn_cli.hpp"

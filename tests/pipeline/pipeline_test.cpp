@@ -5,7 +5,7 @@
 // held by type.
 #include "common/test_util.hpp"
 #include "config/rig_config.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "core/error.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/plugin_instances.hpp"

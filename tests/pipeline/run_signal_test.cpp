@@ -3,7 +3,7 @@
 // 5 s, exits 128 + signal, and leaves summary.json (status interrupted, the frame count),
 // one frames.jsonl line per finished frame, and no temporary file.
 #include "common/test_util.hpp"
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "spawn_cli.hpp"
 
 #include <gtest/gtest.h>

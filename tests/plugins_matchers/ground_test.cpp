@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // ground plugin: METHOD.md Eq. 1 (camera frame -> ground frame), directly and through the host.
-#include "ground/ground_frame.hpp"
+#include "method/ground_frame.hpp"
 #include "plugin_fixtures.hpp"
 
 #include <gtest/gtest.h>
@@ -32,13 +32,13 @@ const Case kTilted[] = {
 
 TEST(GroundFrame, Eq1AtZeroAndTenDegrees) {
     for (const Case &c : kLevel) {
-        const auto g = ground::GroundFrame(1500, 0).toGround(c.xc, c.yc, c.zc);
+        const auto g = method::GroundFrame(1500, 0).toGround(c.xc, c.yc, c.zc);
         EXPECT_NEAR(g[0], c.x, 1e-9);
         EXPECT_NEAR(g[1], c.y, 1e-9);
         EXPECT_NEAR(g[2], c.z, 1e-9);
     }
     for (const Case &c : kTilted) {
-        const auto g = ground::GroundFrame(1500, 10).toGround(c.xc, c.yc, c.zc);
+        const auto g = method::GroundFrame(1500, 10).toGround(c.xc, c.yc, c.zc);
         EXPECT_NEAR(g[0], c.x, 1e-5);
         EXPECT_NEAR(g[1], c.y, 1e-5);
         EXPECT_NEAR(g[2], c.z, 1e-5);

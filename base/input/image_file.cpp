@@ -6,7 +6,9 @@
 // header checked.
 #include "input/image_file.hpp"
 
-#include "input/numbers.hpp"
+#include "input/integer_range.hpp"
+
+#include <binocle/numbers.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -17,6 +19,7 @@
 #include <cctype>
 #include <cerrno>
 #include <csetjmp>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -250,13 +253,13 @@ bool inspectPfm(const uint8_t *d, size_t size, ImageInfo &info, std::string &pro
     int64_t width = 0, height = 0;
     if (!t.next(w) || !t.next(h) || !t.next(third))
         return fail(problem, "PFM header is incomplete: expected width, height and scale");
-    if (!parseInteger(w, width, &why, 1) || !parseInteger(h, height, &why, 1))
+    if (!parseInteger(w, width, &why, 1, INT64_MAX) || !parseInteger(h, height, &why, 1, INT64_MAX))
         return fail(problem, "PFM header: width '" + w + "' and height '" + h + "' must be positive decimal integers");
     info.width = width;
     info.height = height;
     if (!checkSize(info, problem, limits)) return false;
     double scale = 0;
-    if (!parseReal(third, scale, &why) || scale == 0)
+    if (!sdk::parseDecimalReal(third, scale, &why) || scale == 0)
         return fail(problem, "PFM header: scale '" + third + "' must be a non-zero decimal number");
     info.scale = scale;
     info.dataOffset = t.pos + 1; // one whitespace character ends the header

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Whole-file reads and crash-safe writes.
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 
-#include "core/error.hpp"
+#include "error/error.hpp"
 
 #include <atomic>
 #include <cerrno>

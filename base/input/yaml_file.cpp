@@ -2,7 +2,10 @@
 // One YAML loader: UTF-8, syntax and duplicate keys checked, size bounded.
 #include "input/yaml_file.hpp"
 
-#include "input/text.hpp"
+#include "input/names.hpp"
+#include "input/utf8.hpp"
+
+#include <binocle/text.hpp>
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
@@ -52,7 +55,7 @@ void checkDuplicateKeys(const YAML::Node &root, const std::string &origin) {
             if (kv.first.IsScalar()) {
                 auto [it, fresh] = keys.emplace(kv.first.Scalar(), kv.first.Mark());
                 if (!fresh)
-                    throw YamlError(at(origin, kv.first.Mark()) + ": key '" + printable(kv.first.Scalar()) +
+                    throw YamlError(at(origin, kv.first.Mark()) + ": key '" + sdk::printable(kv.first.Scalar()) +
                                     "' given twice in one map: first at " + lineColumn(it->second) + ", again at " +
                                     lineColumn(kv.first.Mark()) + "; remove one of them");
             }
@@ -149,7 +152,7 @@ std::optional<UnknownKey> findUnknownKey(const YAML::Node &map, const std::vecto
         std::string list;
         for (const auto &v : valid) list += (list.empty() ? "" : ", ") + v;
         return UnknownKey{kv.first, name,
-                          "unknown key '" + printable(name, 60) + "'" + (owner.empty() ? "" : " " + owner) + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
+                          "unknown key '" + sdk::printable(name, 60) + "'" + (owner.empty() ? "" : " " + owner) + (hint.empty() ? "" : "; did you mean '" + hint + "'?") +
                               " (valid keys: " + (list.empty() ? "none" : list) + ")"};
     }
     return std::nullopt;

@@ -5,7 +5,7 @@
 #include <array>
 #include <cmath>
 
-namespace binocle::ground {
+namespace binocle::method {
 
 // Camera frame: origin at the left optical centre, Xc right, Yc down, Zc forward.
 // Ground frame: origin on the ground below it, X lateral (right), Y range, Z height.
@@ -28,4 +28,4 @@ private:
     double heightMm_, sin_, cos_;
 };
 
-} // namespace binocle::ground
+} // namespace binocle::method

@@ -1,14 +1,11 @@
 // SPDX-License-Identifier: MIT
-// The one strict reader of numbers in untrusted text: the SDK's (binocle/numbers.hpp),
-// with the range checks the framework's callers share.
-#include "input/numbers.hpp"
+// Integers within a range, on the SDK's number reader (binocle/numbers.hpp).
+#include "input/integer_range.hpp"
 
 #include <binocle/numbers.hpp>
 
-#include <cerrno>
 #include <climits>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 
 namespace binocle::input {
@@ -29,10 +26,6 @@ bool parseInteger(std::string_view text, int64_t &out, std::string *why, int64_t
     if (v > max) return fail(why, "expected an integer <= " + std::to_string(max));
     out = v;
     return true;
-}
-
-bool parseReal(std::string_view text, double &out, std::string *why, bool allowNonFinite) {
-    return sdk::parseDecimalReal(text, out, why, allowNonFinite);
 }
 
 bool fitsInt(double v) { return std::isfinite(v) && v > static_cast<double>(INT_MIN) - 1.0 && v < static_cast<double>(INT_MAX) + 1.0; }

@@ -1,44 +1,11 @@
 // SPDX-License-Identifier: MIT
-// UTF-8 validity, safe names and the nearest word (printable excerpts and confined
-// paths are the SDK's, binocle/text.hpp).
-#include "input/text.hpp"
-
-#include <binocle/text.hpp>
+// Safe names and the nearest word.
+#include "input/names.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdint>
 #include <vector>
 
 namespace binocle::input {
-
-bool isValidUtf8(std::string_view text, size_t *badOffset) {
-    for (size_t i = 0; i < text.size();) {
-        const size_t n = sdk::utf8SequenceLength(text, i);
-        if (n == 0) {
-            if (badOffset) *badOffset = i;
-            return false;
-        }
-        i += n;
-    }
-    return true;
-}
-
-std::string sanitizeUtf8(std::string_view text) {
-    std::string out;
-    out.reserve(text.size());
-    for (size_t i = 0; i < text.size();) {
-        const size_t n = sdk::utf8SequenceLength(text, i);
-        if (n == 0) {
-            out += "\xEF\xBF\xBD";
-            ++i;
-        } else {
-            out.append(text.substr(i, n));
-            i += n;
-        }
-    }
-    return out;
-}
 
 bool isSafeName(std::string_view name, std::string *why) {
     auto fail = [&](const char *what) {
@@ -82,23 +49,6 @@ std::string nearestWord(const std::string &word, const std::vector<std::string> 
         if (d < bestD || (d == bestD && !best.empty() && prefix > bestPrefix)) bestD = d, best = c, bestPrefix = prefix;
     }
     return best;
-}
-
-std::string xmlEscape(std::string_view s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        case '\'': out += "&apos;"; break;
-        default:
-            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r') out += ' ';
-            else out += c;
-        }
-    }
-    return out;
 }
 
 } // namespace binocle::input

@@ -2,7 +2,7 @@
 // Drawing density views: colour cells, axes in metres, titles, colour scale, overlays.
 #include "method/density_render.hpp"
 
-#include "core/atomic_file.hpp"
+#include "files/atomic_file.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
