@@ -14,8 +14,12 @@
 #include <binocle/text.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <optional>
 #include <spdlog/spdlog.h>
 #include <sstream>
@@ -184,8 +188,33 @@ std::vector<DesignCandidate> rankCandidates(const DesignRequest &request, const 
     return cands;
 }
 
+// A private folder under $TMPDIR (mkdtemp: 0700, a fresh name), removed with its content
+// when this goes: the simulated runs of a design without an output folder, which nobody
+// asked to keep and which must not land, unclaimed, in the working folder.
+class ScratchFolder {
+public:
+    ScratchFolder() {
+        std::string pattern = (std::filesystem::temp_directory_path() / "binocle-design.XXXXXX").string();
+        if (!::mkdtemp(pattern.data()))
+            throw Error("design: cannot make a folder for the simulated runs under " +
+                        std::filesystem::temp_directory_path().string() + ": " + std::strerror(errno) + " (set TMPDIR, or give an output folder)");
+        path_ = pattern;
+    }
+    ~ScratchFolder() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    ScratchFolder(const ScratchFolder &) = delete;
+    ScratchFolder &operator=(const ScratchFolder &) = delete;
+    const std::string &path() const { return path_; }
+
+private:
+    std::string path_;
+};
+
 // simulate: η3D measured on the simulated rig for the best `simulate_count` by figures,
-// averaged over the band (a configuration is as good as it is across it).
+// averaged over the band (a configuration is as good as it is across it). The runs go
+// into OUT/simulated, or, without an output folder, into a scratch folder removed after.
 void simulate(const DesignRequest &request, const std::vector<double> &ranges, std::vector<DesignCandidate> &cands) {
     const size_t n = std::min(cands.size(), static_cast<size_t>(request.simulate_count));
     PluginHost host;
@@ -199,8 +228,10 @@ void simulate(const DesignRequest &request, const std::vector<double> &ranges, s
             which.push_back(i);
         }
     Experiment e = makeExperiment("design", rig, tests, host);
+    std::optional<ScratchFolder> scratch;
+    if (request.out.empty()) scratch.emplace();
     ExperimentOptions opt;
-    opt.out_dir = (request.out.empty() ? std::string("out/design") : request.out) + "/simulated";
+    opt.out_dir = (scratch ? scratch->path() : request.out) + "/simulated";
     opt.progress = request.progress;
     const ExperimentResult result = runExperiment(e, host, opt);
     std::vector<double> sum(n, 0), cnt(n, 0);

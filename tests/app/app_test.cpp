@@ -12,7 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 using binocle::test::TempDir;
@@ -212,6 +214,37 @@ TEST(AppDesign, OutGetsTheFilesAndAnotherKindIsRefused) {
     const std::string message = thrown<binocle::Error>([&] { app::design(request); });
     EXPECT_TRUE(contains(message, "holds a recording (frames.csv)") && contains(message, "--force")) << message;
     EXPECT_FALSE(std::filesystem::exists(request.out + "/design.json"));
+}
+
+// Without an output folder the simulated runs go into a scratch folder under $TMPDIR that
+// is removed afterwards: nothing lands in the working folder (it used to get an unclaimed
+// out/design/simulated), nothing is left in $TMPDIR, and the candidates still get η3D.
+TEST(AppDesign, SimulatingWithoutAFolderWritesNothingAndLeavesNothing) {
+    TempDir tmp;
+    const std::string work = tmp.str("work"), scratch = tmp.str("tmp");
+    std::filesystem::create_directories(work);
+    std::filesystem::create_directories(scratch);
+    const std::filesystem::path before = std::filesystem::current_path();
+    const char *oldTmp = std::getenv("TMPDIR");
+    const std::string savedTmp = oldTmp ? oldTmp : "";
+    ::setenv("TMPDIR", scratch.c_str(), 1);
+    std::filesystem::current_path(work);
+    app::DesignRequest request;
+    request.range = "6000";
+    request.lenses = "8";
+    request.baselines = "100";
+    request.simulate = true;
+    request.simulate_count = 1;
+    request.progress = false;
+    request.rig = kSimRig;
+    app::DesignResult result;
+    EXPECT_NO_THROW(result = app::design(request));
+    std::filesystem::current_path(before);
+    if (oldTmp) ::setenv("TMPDIR", savedTmp.c_str(), 1); else ::unsetenv("TMPDIR");
+    ASSERT_EQ(result.candidates.size(), 1u);
+    EXPECT_TRUE(std::isfinite(result.candidates[0].eta_3d) && result.candidates[0].eta_3d > 0) << result.candidates[0].eta_3d;
+    EXPECT_TRUE(std::filesystem::is_empty(work)) << "the working folder got files";
+    EXPECT_TRUE(std::filesystem::is_empty(scratch)) << "the scratch folder was left in $TMPDIR";
 }
 
 } // namespace
