@@ -11,14 +11,20 @@
 #     pipeline's interfaces, never the reverse);
 #   - an include of framework/app/ from any framework module but cli/ (the application
 #     layer is on top: the CLI and the Python module call it, nothing below does);
+#   - an include of core/output_folder.hpp from the front ends, framework/cli/ and
+#     python/ (the application layer claims the output folder: a front end fills a
+#     request and calls it);
+#   - an include from python/ into plugins/ (the Python module, a front end like the CLI,
+#     uses the framework, base/ and the SDK);
 #   - a module name used by both base/ and framework/ ("<module>/x.hpp" would find one
 #     of them by the search order alone);
 #   - any cycle between modules (base/<module>/ and framework/<module>/ together): the
 #     module graph is made from the includes, and each cycle is reported with the
 #     includes that make it.
 # An include is resolved as the compiler would find it: beside the including file, then
-# under sdk/include, base/, framework/ and plugins/; one that resolves to no file of the
-# tree (the standard library, OpenCV ...) is not looked at.
+# under sdk/include, base/, framework/ and plugins/ (and, for python/, the tree's root:
+# "python/run.hpp"); one that resolves to no file of the tree (the standard library,
+# OpenCV, pybind11 ...) is not looked at.
 # Usage: scripts/check-layers.sh [SOURCE_DIR]  (default: the tree holding this script).
 # Run by CTest as `check_layers`; tests/layers/planted_includes.sh checks that it fails
 # on includes planted in a copy of the tree (CTest `check_layers_planted`).
@@ -33,12 +39,14 @@ ROOT = os.path.abspath(sys.argv[1])
 SHARED_PLUGIN_FOLDER = "common"  # plugins/common/: what every plugin may include
 FORBIDDEN_MODULE_EDGES = {("pipeline", "rosbag")}  # (from, to): never
 APPLICATION_MODULE, APPLICATION_CALLERS = "app", {"cli"}  # framework/app/: included by cli/ (and python/) only
+OUTPUT_FOLDER = os.path.join("framework", "core", "output_folder.hpp")  # claimed by app/ only
+FRONT_ENDS = {("framework", "cli"), ("python", None)}  # what parses arguments into app/ requests
 SUFFIXES = (".h", ".hpp", ".c", ".cpp", ".cc", ".inl")
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
 SEARCH = [os.path.join(ROOT, p) for p in ("sdk/include", "base", "framework", "plugins")]
 MODULAR = ("base", "framework")  # layers made of modules, one folder each
 
-for top in ("sdk", "base", "framework", "plugins"):
+for top in ("sdk", "base", "framework", "plugins", "python"):
     if not os.path.isdir(os.path.join(ROOT, top)):
         sys.exit(f"check-layers: {ROOT}: no {top}/ folder: expected the root of a Binocle tree")
 
@@ -51,8 +59,10 @@ def files_under(top):
                 yield os.path.join(base, name)
 
 
-def resolve(including, quote, path):
+def resolve(including, quote, path, layer):
     candidates = ([os.path.dirname(including)] if quote == '"' else []) + SEARCH
+    if layer == "python":  # the module's include path has the tree's root too
+        candidates.append(ROOT)
     for base in candidates:
         target = os.path.normpath(os.path.join(base, path))
         if os.path.isfile(target):
@@ -81,7 +91,7 @@ for name in sorted(modules_of("base") & modules_of("framework")):
     problems.append(f"base/{name}/ and framework/{name}/: one module name in two layers; "
                     f'"{name}/..." includes would find one of them by the search order alone: rename one')
 
-for top in ("sdk", "base", "plugins", "framework"):
+for top in ("sdk", "base", "plugins", "framework", "python"):
     for f in files_under(top):
         rel = os.path.relpath(f, ROOT)
         layer, module = where(rel)
@@ -90,12 +100,19 @@ for top in ("sdk", "base", "plugins", "framework"):
                 m = INCLUDE.match(line)
                 if not m:
                     continue
-                target = resolve(f, m.group(1), m.group(2))
+                target = resolve(f, m.group(1), m.group(2), layer)
                 if target is None:
                     continue
                 to_layer, to_module = where(target)
                 close = ">" if m.group(1) == "<" else '"'
                 at = f"{rel}:{number}: #include {m.group(1)}{m.group(2)}{close}"
+                if (layer, module) in FRONT_ENDS and target == OUTPUT_FOLDER:
+                    front = f"framework/{module}/" if module else f"{layer}/"
+                    problems.append(f"{at} ({target}): {front} includes the output folder's claim; the application "
+                                    f"layer (framework/{APPLICATION_MODULE}/) claims it: a front end fills a request and calls it")
+                if layer == "python" and to_layer not in ("sdk", "base", "framework", "python"):
+                    problems.append(f"{at} ({target}): python/ includes {to_layer}/; "
+                                    "the Python module may include the SDK, base/ and framework/ only")
                 if layer == "sdk" and to_layer != "sdk":
                     problems.append(f"{at} ({target}): the SDK includes {to_layer}/; the SDK must stand alone")
                 elif layer == "base" and to_layer not in ("sdk", "base"):
@@ -229,5 +246,6 @@ if problems:
 modules = sorted(graph)
 print(f"check-layers: ok: {sum(len(v) for v in edges.values())} includes between {len(modules)} modules of base/ and "
       "framework/, no cycle; sdk/ stands alone; base/ uses the SDK only; plugins use the SDK, base/ and "
-      f"plugins/{SHARED_PLUGIN_FOLDER}/ only; framework/{APPLICATION_MODULE}/ is included by cli/ only")
+      f"plugins/{SHARED_PLUGIN_FOLDER}/ only; framework/{APPLICATION_MODULE}/ is included by cli/ and python/ only and "
+      "claims the output folder (they do not); python/ uses the SDK, base/ and framework/ only")
 PY

@@ -1,13 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `binocle view RIG.yaml`: the rig's pipeline with a live web page on this machine.
+#include "app/view.hpp"
 #include "cli/command.hpp"
-#include "core/output_folder.hpp"
-#include "viewer/viewer.hpp"
-#include "viewer/web_guard.hpp"
-
-#include <binocle/text.hpp>
-
-#include <arpa/inet.h>
 
 #include <nlohmann/json.hpp>
 
@@ -18,43 +12,15 @@ namespace {
 
 struct ViewArgs {
     RigArgs rig;
-    viewer::ViewOptions options;
-    int64_t frames = -1;
-    bool force = false;
+    app::ViewRequest request; // the page's options (--out among them), frames, force
 };
 
-// --bind and --allow-remote are read here, before any plugin opens: a mistake in them is
-// wrong usage (exit status 2), not a failed run.
-void checkBind(const viewer::ViewOptions &o) {
-    unsigned char bytes[16];
-    if (::inet_pton(AF_INET, o.address.c_str(), bytes) != 1 && ::inet_pton(AF_INET6, o.address.c_str(), bytes) != 1)
-        throw UsageError("--bind " + sdk::printable(o.address) + ": expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
-    if (const std::string refusal = viewer::remoteBindRefusal(o.address, o.allow_remote); !refusal.empty())
-        throw UsageError(refusal);
-}
-
 int view(ViewArgs &args) {
-    viewer::ViewOptions o = args.options;
-    checkBind(o);
-    o.rig_file = args.rig.file;
-    o.max_frames = args.frames;
-    // --out is the view's while it runs (snapshots are a run's outputs, by name: written
-    // into a run's folder they would replace its frames); made again, and gone when no
-    // snapshot was taken.
-    const OutputFolder folder(o.out_dir, OutputClaim{OutputKind::View, args.force, "binocle view"});
-    PluginHost host;
-    host.scan();
-    viewer::ViewSummary s;
-    try {
-        for (const auto &text : args.rig.overrides) o.overrides.push_back(Override::parse(text));
-        // The rig with the command line's --set is loaded before the page opens: a bad
-        // --set escapes from there only, never from the page's own commands.
-        s = viewer::runView(o, host, [](const std::string &url) {
-            std::cout << "binocle view: open " << url << "\n" << std::flush;
-        });
-    } catch (const OverrideError &e) {
-        throw UsageError(e.what()); // a bad --set is a bad value on the command line: exit 2, as in run
-    }
+    args.request.rig_file = args.rig.file;
+    args.request.overrides = args.rig.overrides;
+    const viewer::ViewSummary s = app::view(args.request, [](const std::string &url) {
+        std::cout << "binocle view: open " << url << "\n" << std::flush;
+    });
     const nlohmann::ordered_json j = {{"frames", s.frames},
                                       {"frames_sent", s.frames_sent},
                                       {"encode_ms_per_frame", s.frames_sent > 0 ? 1000 * s.encode_seconds / s.frames_sent : 0.0},
@@ -82,29 +48,29 @@ Register viewCommand{{"view", "a live web page of a rig: images, disparity, dens
               "Example: binocle view configs/rigs/sim-videre.yaml --port 8080",
               defineOnRig<ViewArgs>(
                   [](CLI::App &app, ViewArgs &args) {
-                      addNumber(app, "--port", args.options.port, "TCP port (0: any free port)", "N", wholeNumberIn(0, 65535))
+                      addNumber(app, "--port", args.request.options.port, "TCP port (0: any free port)", "N", wholeNumberIn(0, 65535))
                           ->capture_default_str();
-                      app.add_option("--bind", args.options.address, "address to listen on (an IP address)")
+                      app.add_option("--bind", args.request.options.address, "address to listen on (an IP address)")
                           ->type_name("ADDR")
                           ->capture_default_str();
-                      app.add_flag("--allow-remote", args.options.allow_remote,
+                      app.add_flag("--allow-remote", args.request.options.allow_remote,
                                    "serve a --bind address other than loopback (the token then crosses the network in clear)");
-                      app.add_option("--allow-host", args.options.allowed_hosts,
+                      app.add_option("--allow-host", args.request.options.allowed_hosts,
                                      "a Host name to serve besides the address a request arrives on (a DNS name of this machine)")
                           ->type_name("NAME");
-                      app.add_option("--out", args.options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
-                      app.add_flag("--force", args.force, "replace what --out holds when another command (or you) wrote it");
-                      addNumber(app, "--display-fps", args.options.display_fps,
+                      app.add_option("--out", args.request.options.out_dir, "where snapshots go")->type_name("DIR")->capture_default_str();
+                      app.add_flag("--force", args.request.force, "replace what --out holds when another command (or you) wrote it");
+                      addNumber(app, "--display-fps", args.request.options.display_fps,
                                 "most frames per second sent to browsers (each gets no more than it can draw)", "F", positiveNumber())
                           ->capture_default_str();
-                      addNumber(app, "--cloud-points", args.options.cloud_points, "most points drawn in the 3D view (thinned evenly)", "N",
+                      addNumber(app, "--cloud-points", args.request.options.cloud_points, "most points drawn in the 3D view (thinned evenly)", "N",
                                 atLeast(1))
                           ->capture_default_str();
-                      addNumber(app, "--cloud-fps", args.options.cloud_fps,
+                      addNumber(app, "--cloud-fps", args.request.options.cloud_fps,
                                 "most new clouds per second for the 3D view (the images come at --display-fps)", "F", positiveNumber())
                           ->capture_default_str();
-                      addFramesOption(app, args.frames, "stop after N frames (measurements)");
-                      app.add_flag("--paused", args.options.paused, "start paused on the first frame");
+                      addFramesOption(app, args.request.frames, "stop after N frames (measurements)");
+                      app.add_flag("--paused", args.request.options.paused, "start paused on the first frame");
                   },
                   view)}};
 

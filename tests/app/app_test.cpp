@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
 // The application layer called directly, as the CLI and the Python module call it: the
-// output folder's refusals in each caller's words, the bad requests, and the design
-// ranking against the one `binocle design` printed before the ranking moved here.
+// output folder's refusals in each caller's words, the bad requests (the view's address,
+// the report's file), and the design ranking against the one `binocle design` printed
+// before the ranking moved here.
 #include "common/test_util.hpp"
 
 #include "app/design.hpp"
 #include "app/experiment_run.hpp"
 #include "app/record.hpp"
+#include "app/report.hpp"
 #include "app/run_rig.hpp"
+#include "app/view.hpp"
 #include "config/rig_config.hpp"
 
 #include <gtest/gtest.h>
@@ -245,6 +248,116 @@ TEST(AppDesign, SimulatingWithoutAFolderWritesNothingAndLeavesNothing) {
     EXPECT_TRUE(std::isfinite(result.candidates[0].eta_3d) && result.candidates[0].eta_3d > 0) << result.candidates[0].eta_3d;
     EXPECT_TRUE(std::filesystem::is_empty(work)) << "the working folder got files";
     EXPECT_TRUE(std::filesystem::is_empty(scratch)) << "the scratch folder was left in $TMPDIR";
+}
+
+// The view's folder is claimed before the rig is read or any plugin opens: the rig named
+// does not exist, and the refusal is the folder's, in the caller's words.
+TEST(AppView, AFolderHoldingARecordingIsRefusedBeforeAnyPluginOpens) {
+    TempDir tmp;
+    const std::string dir = makeRecordingFolder(tmp.str("rec"));
+    app::ViewRequest request;
+    request.rig_file = tmp.str("no-such-rig.yaml");
+    request.options.out_dir = dir;
+    request.options.port = 0;
+    bool listened = false;
+    const auto listening = [&](const std::string &) { listened = true; };
+    const std::string cli = thrown<binocle::Error>([&] { app::view(request, listening); });
+    EXPECT_TRUE(contains(cli, "output folder " + dir + " holds a recording (frames.csv)")) << cli;
+    EXPECT_TRUE(contains(cli, "binocle view writes") && contains(cli, "pass --force")) << cli;
+    EXPECT_FALSE(contains(cli, "no-such-rig")) << cli;
+    request.caller.command = "binocle.view";
+    const std::string python = thrown<binocle::Error>([&] { app::view(request, listening); });
+    EXPECT_TRUE(contains(python, "binocle.view writes") && contains(python, "pass force=True")) << python;
+    EXPECT_FALSE(listened);
+    EXPECT_EQ(binocle::entriesOf(dir), std::vector<std::string>{"frames.csv"});
+}
+
+// A bad address is a bad request (exit status 2), found before the folder is made.
+TEST(AppView, ABadBindIsARequestErrorBeforeTheFolderIsMade) {
+    TempDir tmp;
+    app::ViewRequest request;
+    request.rig_file = kSimRig;
+    request.options.out_dir = tmp.str("view");
+    request.options.address = "localhost";
+    const auto listening = [](const std::string &) { ADD_FAILURE() << "served"; };
+    EXPECT_EQ(thrown<app::RequestError>([&] { app::view(request, listening); }),
+              "--bind localhost: expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
+    request.caller.command = "binocle.view";
+    EXPECT_EQ(thrown<app::RequestError>([&] { app::view(request, listening); }),
+              "bind='localhost': expected an IP address, e.g. 127.0.0.1 or ::1 (not a name)");
+    request.options.address = "0.0.0.0";
+    const std::string remote = thrown<app::RequestError>([&] { app::view(request, listening); });
+    EXPECT_TRUE(contains(remote, "Add --allow-remote to serve it anyway")) << remote;
+    request.options.address = "127.0.0.1";
+    request.overrides = {"matcher"};
+    const std::string override = thrown<app::RequestError>([&] { app::view(request, listening); });
+    EXPECT_TRUE(contains(override, "matcher")) << override;
+    EXPECT_FALSE(std::filesystem::exists(request.options.out_dir)); // made for the claim, gone again
+}
+
+// A short view on loopback: the page's URL is given, the frames run, and the folder made
+// for snapshots is gone again since none was taken.
+TEST(AppView, AViewServesItsFramesAndLeavesNoEmptyFolder) {
+    TempDir tmp;
+    app::ViewRequest request;
+    request.rig_file = kSimRig;
+    request.options.out_dir = tmp.str("view");
+    request.options.port = 0;
+    request.frames = 1; // the simulated E1 rig's source gives one pair
+    std::string url;
+    const binocle::viewer::ViewSummary summary = app::view(request, [&](const std::string &u) { url = u; });
+    EXPECT_EQ(summary.frames, 1);
+    EXPECT_TRUE(contains(url, "http://127.0.0.1:")) << url;
+    EXPECT_FALSE(std::filesystem::exists(request.options.out_dir));
+}
+
+// An experiment's folder, as far as the report's checks look: its results.json.
+std::string makeExperimentFolder(const std::string &dir) {
+    std::filesystem::create_directories(dir);
+    writeText(dir + "/results.json", "{}\n");
+    return dir;
+}
+
+TEST(AppReport, AnOutputThatIsAFolderOrServesSeveralExperimentsIsRefused) {
+    TempDir tmp;
+    const std::string demo = tmp.str("demo");
+    makeExperimentFolder(demo + "/e1");
+    makeExperimentFolder(demo + "/e2");
+    const std::string folder = tmp.str("reports");
+    std::filesystem::create_directories(folder);
+    app::ReportRequest request;
+    request.dir = demo + "/e1";
+    request.output = folder;
+    EXPECT_EQ(thrown<app::RequestError>([&] { app::writeReports(request); }),
+              "--output " + folder + ": is a folder; expected the report's file name (e.g. " + folder + "/report.html)");
+    request.output = tmp.str("new/");
+    EXPECT_TRUE(contains(thrown<app::RequestError>([&] { app::writeReports(request); }), ": is a folder;"));
+    request.dir = demo;
+    request.output = tmp.str("report.html");
+    EXPECT_EQ(thrown<app::RequestError>([&] { app::writeReports(request); }),
+              "--output " + request.output + ": " + demo + " holds 2 experiments; without --output each gets DIR/<experiment>/report.html");
+    request.caller.command = "binocle.report";
+    EXPECT_TRUE(contains(thrown<app::RequestError>([&] { app::writeReports(request); }), "without output each gets"));
+    EXPECT_TRUE(std::filesystem::is_empty(folder));
+    EXPECT_FALSE(std::filesystem::exists(request.output));
+    EXPECT_FALSE(std::filesystem::exists(demo + "/e1/report.html"));
+}
+
+// Each experiment folder is locked while its report is written: one that an experiment
+// still writes into (its claim held) is refused, and its report is not written.
+TEST(AppReport, AnExperimentStillWritingIsRefused) {
+    TempDir tmp;
+    const std::string dir = tmp.str("e1");
+    const binocle::OutputFolder running(dir, binocle::OutputClaim{binocle::OutputKind::Experiment, false, "binocle experiment"});
+    makeExperimentFolder(dir); // its first results written
+    app::ReportRequest request;
+    request.dir = dir;
+    std::vector<std::string> written;
+    const std::string message =
+        thrown<binocle::Error>([&] { app::writeReports(request, [&](const std::string &path) { written.push_back(path); }); });
+    EXPECT_TRUE(contains(message, "output folder " + dir + " is in use by")) << message;
+    EXPECT_TRUE(written.empty());
+    EXPECT_FALSE(std::filesystem::exists(dir + "/report.html"));
 }
 
 } // namespace
