@@ -4,7 +4,7 @@
 // and what was expected, never pybind11's cast error or a silent conversion.
 #pragma once
 
-#include "core/error.hpp"
+#include "app/request.hpp"
 
 #include <pybind11/pybind11.h>
 
@@ -18,10 +18,9 @@ namespace binocle::python {
 
 namespace py = pybind11;
 
-// A mistake in the call's arguments: raised as binocle.UsageError (a ValueError).
-struct ArgumentError : Error {
-    using Error::Error;
-};
+// A mistake in the call's arguments: the application layer's mistake in a request, raised
+// as binocle.UsageError (a ValueError), as the CLI's UsageError is the same type.
+using ArgumentError = app::RequestError;
 
 // A whole number from `least` to `most`: a Python int or an integer numpy scalar
 // (anything with __index__), not a bool, a float or a text. `none`, when not empty, says

@@ -76,9 +76,7 @@ void translate(std::exception_ptr p) {
         if (p) std::rethrow_exception(p);
     } catch (const OverrideError &e) {
         PyErr_SetString(g_usageError, e.what());
-    } catch (const ArgumentError &e) {
-        PyErr_SetString(g_usageError, e.what());
-    } catch (const app::RequestError &e) {
+    } catch (const app::RequestError &e) { // ArgumentError too
         PyErr_SetString(g_usageError, e.what());
     } catch (const PluginError &e) {
         PyErr_SetString(g_pluginError, e.what());

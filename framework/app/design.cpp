@@ -258,7 +258,7 @@ DesignResult design(const DesignRequest &request) {
     // out is the design's own folder (marked): another command's, or the user's own
     // files, are refused unless forced.
     std::optional<OutputFolder> folder;
-    if (!request.out.empty()) folder.emplace(request.out, OutputClaim{OutputKind::Design, request.force, request.caller.command});
+    if (!request.out.empty()) folder.emplace(request.out, request.caller.claim(OutputKind::Design, request.force));
     if (request.simulate) simulate(request, result.ranges, result.candidates);
     result.simulated = request.simulate;
     if (!request.out.empty()) {

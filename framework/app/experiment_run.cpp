@@ -45,7 +45,7 @@ ExperimentRun::ExperimentRun(const ExperimentRequest &request) : host_(std::make
     // first test runs.
     experiment_ = loadExperiment(request, *host_);
     options_ = experimentOptions(request, experiment_);
-    folder_.emplace(options_.out_dir, OutputClaim{OutputKind::Experiment, request.force, request.caller.command});
+    folder_.emplace(options_.out_dir, request.caller.claim(OutputKind::Experiment, request.force));
 }
 
 ExperimentRun::~ExperimentRun() = default;
@@ -60,7 +60,7 @@ void ExperimentRun::release() {
 ExperimentResult mergeExperiment(const MergeRequest &request) {
     PluginHost host;
     host.scan();
-    const OutputFolder folder(request.out, OutputClaim{OutputKind::Experiment, request.force, request.caller.command});
+    const OutputFolder folder(request.out, request.caller.claim(OutputKind::Experiment, request.force));
     return mergeExperimentResults(request.out, request.folders, host, request.force);
 }
 

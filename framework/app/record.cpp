@@ -28,7 +28,7 @@ RecordResult record(const RigConfig &rig, const RecordRequest &request) {
     options.sink = request.format == "mcap" ? rosbagRecordingSink(request.rosbag) : folderRecordingSink();
     // One recorder per folder, marked as a recording; the writer itself refuses a folder
     // that holds anything (a recording is never written over, forced or not).
-    const OutputFolder folder(request.out, OutputClaim{OutputKind::Recording, false, caller.command});
+    const OutputFolder folder(request.out, caller.claim(OutputKind::Recording, false));
     return recordRig(rig, request.out, options);
 }
 

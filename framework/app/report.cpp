@@ -29,7 +29,7 @@ std::vector<std::string> writeReports(const ReportRequest &request, const std::f
     for (const auto &dir : dirs) {
         // A lock only (no kind): not into a folder an experiment still writes.
         std::optional<OutputFolder> folder;
-        if (output.empty()) folder.emplace(dir, OutputClaim{OutputKind::None, false, caller.command});
+        if (output.empty()) folder.emplace(dir, caller.claim(OutputKind::None, false));
         paths.push_back(report::writeExperimentReport(dir, output));
         if (written) written(paths.back());
     }

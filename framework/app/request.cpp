@@ -20,6 +20,10 @@ std::string Caller::shown(const std::string &name, const std::string &value) con
     return python() ? name + "='" + text + "'" : arg(name) + " " + text;
 }
 
+OutputClaim Caller::claim(OutputKind kind, bool force) const {
+    return OutputClaim{kind, force, command, python() ? "force=True" : arg("force")};
+}
+
 StopFlag::StopFlag(const std::atomic<bool> *stop) : stop_(stop) {
     if (stop_) return;
     signals_.emplace();

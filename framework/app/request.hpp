@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/error.hpp"
+#include "core/output_folder.hpp"
 #include "pipeline/stop_signal.hpp"
 
 #include <atomic>
@@ -31,6 +32,9 @@ struct Caller {
     std::string arg(const std::string &name) const;
     // An argument with the value the user gave: "--range 6000,", or "range='6000,'".
     std::string shown(const std::string &name, const std::string &value) const;
+    // The claim of an output folder of `kind` by this caller: its command in the lock and
+    // the marker, its spelling of force ("--force", "force=True") in a refusal.
+    OutputClaim claim(OutputKind kind, bool force) const;
 };
 
 // The flag a job polls to stop cleanly: the caller's, or, when the caller gives none,

@@ -15,7 +15,7 @@ RigRun::RigRun(const RigConfig &rig, const PluginHost &host, RunRequest request)
     pipeline_ = std::make_unique<Pipeline>(rig, host);
     // Owned until the summary is written: a second run into the same folder is refused,
     // and so is a folder that holds a recording or an experiment (unless forced).
-    if (!request_.out.empty()) folder_.emplace(request_.out, OutputClaim{OutputKind::Run, request_.force, request_.caller.command});
+    if (!request_.out.empty()) folder_.emplace(request_.out, request_.caller.claim(OutputKind::Run, request_.force));
     // mcap: the frames also go into DIR/bag, a rosbag2 bag (docs/ros2.md): one more writer
     // of the writer stage, after the folder's.
     if (request_.mcap)

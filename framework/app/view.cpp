@@ -28,7 +28,7 @@ viewer::ViewSummary view(const ViewRequest &request, const std::function<void(co
     o.rig_file = request.rig_file;
     o.max_frames = request.frames;
     // out_dir is the view's while it runs; made again, and gone when no snapshot was taken.
-    const OutputFolder folder(o.out_dir, OutputClaim{OutputKind::View, request.force, request.caller.command});
+    const OutputFolder folder(o.out_dir, request.caller.claim(OutputKind::View, request.force));
     PluginHost host;
     host.scan();
     try {

@@ -159,9 +159,7 @@ void OutputFolder::checkKind(const OutputClaim &claim) {
     if (claim.kind == OutputKind::None) return;
     if (entriesOf(dir).empty() || markerOf(dir).first == claim.kind) return mark(claim);
     const std::string held = describeContent(dir);
-    // Python's functions take force=True where the command line takes --force.
-    const bool python = claim.command.rfind("binocle.", 0) == 0;
-    const std::string flag = python ? "force=True" : "--force";
+    const std::string &flag = claim.force_flag;
     // A recording is never written over: `binocle record` has no --force.
     const bool recording = claim.kind == OutputKind::Recording;
     if (!claim.force || recording) {

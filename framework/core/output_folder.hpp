@@ -43,6 +43,8 @@ struct OutputClaim {
     // Replace a folder that holds anything but this kind's output: its entries are removed first.
     bool force = false;
     std::string command; // "binocle run", written beside the pid for whoever finds the lock
+    // How the caller's user asks for `force`, for the refusal: "--force", or Python's "force=True".
+    std::string force_flag = "--force";
 };
 
 // Owns an output folder while alive: the folder is created if needed and locked

@@ -203,8 +203,7 @@ void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispar
         throw Error("matcher '" + record_.name + "': left and right images differ in size or type");
     disparity.create(left.size(), CV_32F);
     disparity.setTo(cv::Scalar(BINOCLE_INVALID_DISPARITY));
-    extras_.clear();
-    impl_->compute(left, right, disparity, extras_);
+    impl_->compute(left, right, disparity, extras_); // each Impl clears extras_ first
     // A disparity is at most the image width; inf, NaN or 1e30 would become cloud points.
     const float limit = static_cast<float>(disparity.cols);
     uint64_t bad = 0;
@@ -229,8 +228,7 @@ void Matcher::compute(const cv::Mat &left, const cv::Mat &right, cv::Mat &dispar
 }
 
 void Matcher::computeInto(const cv::Mat &left, const cv::Mat &right, cv::Mat &disparity) {
-    extras_.clear();
-    impl_->compute(left, right, disparity, extras_);
+    impl_->compute(left, right, disparity, extras_); // each Impl clears extras_ first
 }
 
 std::pair<int32_t, int32_t> Matcher::disparityRange() { return impl_->disparityRange(); }

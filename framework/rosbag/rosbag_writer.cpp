@@ -187,16 +187,17 @@ void RosbagWriter::writePair(int64_t stampLeftNs, int64_t stampRightNs, const cv
         }
     }
     pairEnds_.push_back(writer_->statistics().message_count);
+    countDurablePairs();
 }
 
-int64_t RosbagWriter::durablePairs() {
-    std::lock_guard<std::mutex> lock(mutex_);
+void RosbagWriter::countDurablePairs() {
     const uint64_t durable = writer_->durableMessageCount();
+    int64_t pairs = durablePairs_.load();
     while (!pairEnds_.empty() && pairEnds_.front() <= durable) {
         pairEnds_.pop_front();
-        ++durablePairs_;
+        ++pairs;
     }
-    return durablePairs_;
+    durablePairs_.store(pairs);
 }
 
 void RosbagWriter::writeDisparity(int64_t stampNs, const cv::Mat &disparity, double focalLengthPx, double baselineM,
@@ -294,8 +295,10 @@ void RosbagWriter::close() {
     try {
         writer_->close();
     } catch (const mcap::Error &e) {
+        countDurablePairs(); // the chunks written before the failure still count
         throw Error(e.what());
     }
+    countDurablePairs();
     writeMetadataYaml();
 }
 

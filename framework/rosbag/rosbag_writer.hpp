@@ -19,6 +19,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <atomic>
 #include <deque>
 #include <map>
 #include <memory>
@@ -80,13 +81,15 @@ public:
     uint64_t bytesWritten() const;
     // The pairs (writePair calls) a reader of the bag recovers whole: those whose every
     // message lies in a chunk written whole (mcap::Writer::durableMessageCount). What a
-    // recording may claim, on a full disk too.
-    int64_t durablePairs();
+    // recording may claim, on a full disk too. Counted after each writePair and at close,
+    // so that asking (once per grabbed frame) never waits for a pair being encoded.
+    int64_t durablePairs() const { return durablePairs_.load(); }
 
 private:
     uint16_t channel(const std::string &topic, const char *type);
     void write(const std::string &topic, const char *type, int64_t stampNs, const std::vector<uint8_t> &bytes);
     void writeMetadataYaml();
+    void countDurablePairs(); // with mutex_ held
 
     std::string dir_, file_;
     RosbagOptions options_;
@@ -96,7 +99,7 @@ private:
     std::map<std::string, std::pair<uint16_t, std::string>> channels_; // topic -> id, type
     std::map<std::string, uint64_t> counts_;
     std::deque<uint64_t> pairEnds_; // the message count after each pair not yet durable
-    int64_t durablePairs_ = 0;
+    std::atomic<int64_t> durablePairs_{0};
     uint32_t sequence_ = 0;
     int64_t first_ = INT64_MAX, last_ = INT64_MIN;
     bool closed_ = false;

@@ -4,6 +4,7 @@
 // "gt_disparity" plane): Middlebury's bad-pixel rates, avgerr, rms and invalid share over
 // the non-occluded and all pixels (as MiddEval3's evaldisp counts them), KITTI's D1 over
 // noc and all (as its devkit counts it), and the density.
+#include <binocle/numbers.hpp>
 #include <binocle/plugin.hpp>
 
 #include <algorithm>
@@ -134,10 +135,9 @@ std::vector<double> parseThresholds(const std::string &text) {
         const std::string one = a == std::string::npos ? "" : item.substr(a, b - a + 1);
         item.clear();
         if (one.empty()) return true;
-        char *end = nullptr;
-        errno = 0;
-        const double t = std::strtod(one.c_str(), &end);
-        if (*end != '\0' || errno != 0 || !(t >= 0) || !std::isfinite(t)) return false;
+        double t = 0;
+        // The SDK's one reader of numbers: decimal only ("0x1", "inf", "nan" refused).
+        if (!binocle::sdk::parseDecimalReal(one, t) || !(t >= 0)) return false;
         out.push_back(t);
         return true;
     };

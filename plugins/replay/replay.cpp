@@ -92,7 +92,6 @@ struct Settings {
     McapSettings bag;
 };
 
-std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
 
 // The table above is the one home of each setting's default, bounds and choices: the
 // SDK checked `c` against it before the constructor (a setting the host did not pass is
@@ -180,8 +179,6 @@ Plan planGlob(const Settings &s) {
 // ---- middlebury layout -------------------------------------------------------------------
 // Scene folders of the public datasets (replay_scenes.hpp): Middlebury 2001-2014,
 // MiddEval3, a KITTI pair in a folder of its own; one scene or a folder of them.
-
-bool isMiddleburyScene(const fs::path &folder) { return isSceneFolder(folder); }
 
 // calib.txt: see replay_metadata.hpp.
 PinholePair readMiddleburyCalib(const fs::path &file, const fs::path &leftImage,
@@ -429,10 +426,10 @@ std::string detectLayout(const Settings &s) {
     KittiCameras cams;
     if (fs::is_regular_file(folder / recording::kIndexFile)) return "recording";
     if (isMcapBag(folder.string())) return "mcap";
-    if (isMiddleburyScene(folder)) return "middlebury";
+    if (isSceneFolder(folder)) return "middlebury";
     if (kittiCameras(folder, cams)) return "kitti";
     for (const fs::path &sub : listFolder(folder, true))
-        if (isMiddleburyScene(sub)) return "middlebury";
+        if (isSceneFolder(sub)) return "middlebury";
     throw Error(BINOCLE_ERR_INVALID_ARGUMENT,
                 "replay: folder " + inQuotes(folder) +
                     " holds none of the known layouts: frames.csv (recording), a stereo pair im0/im1, view1/view5, "

@@ -251,9 +251,7 @@ GroundTruth readGroundTruth(const fs::path &path, double scale, int imageWidth) 
     return gt;
 }
 
-namespace {
 std::string inQuotes(const std::filesystem::path &p) { return "'" + p.string() + "'"; }
-} // namespace
 
 // Metadata files are small; a folder or a huge file given in their place is refused
 // here rather than read (std::ifstream on a folder throws "basic_filebuf::underflow").

@@ -50,6 +50,9 @@ GroundTruth readGroundTruth(const std::filesystem::path &path, double scale, int
 // The text of a small metadata file (at most 16 MiB); a folder, a missing or a larger file is
 // refused (sdk::Error naming `what` and the path).
 std::string readText(const std::filesystem::path &path, const std::string &what);
+
+// 'path' in single quotes, as every replay message names a file or folder.
+std::string inQuotes(const std::filesystem::path &p);
 // An image file's size from its header (input::inspectImage), else from decoding it.
 cv::Size imageSizeOf(const std::filesystem::path &path);
 // By its extension: png, jpg, jpeg, bmp, tif, tiff, pgm, ppm, pfm, webp.

@@ -2,13 +2,11 @@
 // The calibration of several scenes (see replay_plan.hpp).
 #include "replay_plan.hpp"
 
+#include "replay_files.hpp"
+
 namespace fs = std::filesystem;
 
 namespace binocle::replay {
-
-namespace {
-std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
-} // namespace
 
 std::string publishFirst(const std::vector<std::pair<fs::path, PinholePair>> &calibrations, const sdk::Host &host) {
     if (calibrations.empty()) return {};

@@ -23,8 +23,6 @@ using sdk::Error;
 
 namespace {
 
-std::string inQuotes(const fs::path &p) { return "'" + p.string() + "'"; }
-
 struct PairNames {
     const char *left, *right;
 };

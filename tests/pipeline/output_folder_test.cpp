@@ -122,7 +122,7 @@ TEST(OutputFolder, AFolderBelongsToTheCommandThatMadeIt) {
     why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Design, false, "binocle design"}); });
     EXPECT_NE(why.find("holds files Binocle did not write there (notes.txt)"), std::string::npos) << why;
     // Python's functions are told force=True.
-    why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Run, false, "binocle.Rig.run"}); });
+    why = errorOf([&] { OutputFolder(mine, OutputClaim{OutputKind::Run, false, "binocle.Rig.run", "force=True"}); });
     EXPECT_NE(why.find("pass force=True"), std::string::npos) << why;
 
     const std::string bag = dir.str("bag");

@@ -174,7 +174,7 @@ TEST(DisparityEvaluator, AGroundTruthBeyondTheWidthOrBadThresholdsAreRefused) {
     } catch (const std::exception &e) {
         EXPECT_NE(std::string(e.what()).find("image width 8"), std::string::npos) << e.what();
     }
-    for (const char *bad : {"[1, x]", "[-1]", "[]"}) {
+    for (const char *bad : {"[1, x]", "[-1]", "[]", "[0x1]", "[inf]", "[1, nan]"}) {
         try {
             EvalRun(std::string("{thresholds_px: ") + bad + "}");
             FAIL() << "accepted thresholds_px " << bad;
